@@ -1,0 +1,13 @@
+#pragma once
+// Each subcommand lives in its own cli/cmd_<name>.cpp and registers itself on the root app.
+// A command's callback throws hw::InputError for bad user input; main() turns that into a
+// message on stderr and exit code 2.
+#include <CLI/CLI.hpp>
+
+namespace hw::cli {
+
+void AddSimulateCommand(CLI::App& app);
+void AddPopCommand(CLI::App& app);
+// Further commands are declared here as their modules land (bounds, brouri, esmaeilani, diagnose, compare).
+
+}  // namespace hw::cli

@@ -1,0 +1,26 @@
+// hwbounds: guaranteed parameter bounds and point estimators for Hammerstein–Wiener systems.
+#include <cstdio>
+#include <exception>
+
+#include <fmt/format.h>
+
+#include "cli/commands.hpp"
+#include "core/csv_table.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"hwbounds: set-membership bounds, estimators and diagnosis for Hammerstein-Wiener systems"};
+  app.require_subcommand(1);
+  hw::cli::AddSimulateCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const hw::InputError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

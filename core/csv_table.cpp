@@ -1,0 +1,131 @@
+#include "core/csv_table.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace hw {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\"");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r\"");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+}  // namespace
+
+bool CsvTable::has(const std::string& name) const {
+  for (const auto& n : names)
+    if (n == name) return true;
+  return false;
+}
+
+const std::vector<double>& CsvTable::column(const std::string& name) const {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return columns[i];
+  std::string available;
+  for (const auto& n : names) available += (available.empty() ? "" : ", ") + n;
+  throw InputError(fmt::format("{}: no column '{}'; the header has: {}", source, name, available));
+}
+
+void CsvTable::add_column(const std::string& name, std::vector<double> values) {
+  if (!columns.empty() && values.size() != rows())
+    throw std::invalid_argument("add_column: length differs from the table's");
+  names.push_back(name);
+  columns.push_back(std::move(values));
+}
+
+CsvTable parse_csv(const std::string& text, const std::string& source, bool allow_nonfinite) {
+  CsvTable table;
+  table.source = source;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string t = trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    auto cells = split(t);
+    if (!have_header) {
+      table.names = cells;
+      for (std::size_t i = 0; i < cells.size(); ++i)
+        if (cells[i].empty())
+          throw InputError(fmt::format("{}:{}: header column {} has no name; expected a header such as 't,u,y'",
+                                       source, line_no, i + 1));
+      table.columns.assign(cells.size(), {});
+      have_header = true;
+      continue;
+    }
+    // Trailing empty cells are allowed (e.g. the WH benchmark's 'fs' column only in row 1).
+    if (cells.size() > table.names.size())
+      throw InputError(fmt::format("{}:{}: {} cells but the header has {} columns", source, line_no,
+                                   cells.size(), table.names.size()));
+    for (std::size_t c = 0; c < table.names.size(); ++c) {
+      double v = std::nan("");
+      if (c < cells.size() && !cells[c].empty()) {
+        char* end = nullptr;
+        v = std::strtod(cells[c].c_str(), &end);
+        if (end == cells[c].c_str() || *end != '\0')
+          throw InputError(fmt::format("{}:{}: column '{}' holds '{}', which is not a number", source,
+                                       line_no, table.names[c], cells[c]));
+      }
+      if (!allow_nonfinite && !std::isfinite(v))
+        throw InputError(fmt::format("{}:{}: column '{}' is {}; every cell must be a finite number", source,
+                                     line_no, table.names[c],
+                                     c < cells.size() && !cells[c].empty() ? cells[c] : "empty"));
+      table.columns[c].push_back(v);
+    }
+  }
+  if (!have_header) throw InputError(fmt::format("{}: empty file; expected a header line and data rows", source));
+  if (table.rows() == 0) throw InputError(fmt::format("{}: header but no data rows", source));
+  return table;
+}
+
+CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_csv(ss.str(), path, allow_nonfinite);
+}
+
+void write_text_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot write", tmp));
+    out << text;
+    if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+void write_csv(const std::string& path, const CsvTable& table, int precision) {
+  std::string out;
+  for (std::size_t c = 0; c < table.names.size(); ++c) out += (c ? "," : "") + table.names[c];
+  out += '\n';
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    for (std::size_t c = 0; c < table.columns.size(); ++c)
+      out += (c ? "," : "") + fmt::format("{:.{}g}", table.columns[c][r], precision);
+    out += '\n';
+  }
+  write_text_atomic(path, out);
+}
+
+}  // namespace hw
