@@ -1,0 +1,154 @@
+#include "relax/constraint_generation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+
+namespace hw::relax {
+
+bool ConstraintGenerationOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  if (order < 0) return fail("order must be >= 0");
+  if (max_rounds < 1) return fail("max_rounds must be >= 1");
+  if (add_per_round < 1) return fail("add_per_round must be >= 1");
+  if (!(violation_tolerance > 0)) return fail("violation_tolerance must be > 0");
+  return sdp.IsValid(error);
+}
+
+ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerationOptions& options,
+                                                         const PolyProblem& core,
+                                                         const std::vector<Polynomial>& candidates,
+                                                         std::vector<int> initial, sdp::SdpSolver& solver,
+                                                         const std::function<void(const std::vector<int>&)>& on_round) {
+  ConstraintGenerationResult result;
+  std::string error;
+  if (!options.IsValid(&error) || !core.IsValid(&error)) {
+    result.message = error;
+    return result;
+  }
+  std::set<int> working(initial.begin(), initial.end());
+  int order = options.order;
+  {
+    PolyProblem all = core;
+    for (const auto& g : candidates) all.inequalities.push_back(g);
+    order = std::max(order == 0 ? all.minimal_order() : order, all.minimal_order());
+  }
+  for (int round = 1; round <= options.max_rounds; ++round) {
+    result.rounds = round;
+    PolyProblem problem = core;
+    for (int i : working) problem.inequalities.push_back(candidates[i]);
+    MomentRelaxation relaxation(problem, order);
+    result.num_moments = relaxation.lmi().c.size();
+    result.num_blocks = relaxation.lmi().blocks.size();
+    const auto sdp = solver.Solve(options.sdp, relaxation.lmi());
+    result.last_sdp = sdp;
+    result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
+    result.sdp_iterations += sdp.iterations;
+    result.working_set.assign(working.begin(), working.end());
+    if (sdp.status == sdp::SdpStatus::kInfeasible) {
+      result.status = RelaxationStatus::kInfeasible;
+      result.message = fmt::format("relaxation with {} of {} data constraints is infeasible: the set is empty",
+                                   working.size(), candidates.size());
+      return result;
+    }
+    if (sdp.status == sdp::SdpStatus::kUnbounded) {
+      result.status = RelaxationStatus::kUnbounded;
+      result.message = "relaxation unbounded: add a box";
+      return result;
+    }
+    if (sdp.status != sdp::SdpStatus::kOptimal) {
+      result.status = RelaxationStatus::kSolverFailed;
+      result.message = fmt::format("{}: {} ({})", sdp.solver, sdp::ToString(sdp.status), sdp.message);
+      return result;
+    }
+    const double sign = relaxation.objective_sign();
+    result.status = RelaxationStatus::kSolved;
+    result.bound = sign * sdp.lower_bound;
+    result.primal_value = sign * sdp.primal_value;
+    const auto y = relaxation.moments(sdp.y);
+    result.first_moments.assign(y.begin() + 1, y.begin() + 1 + core.num_vars);
+
+    // Check every omitted candidate at the returned moments.
+    std::vector<std::pair<double, int>> violated;
+    double worst = 0.0;
+    for (int i = 0; i < static_cast<int>(candidates.size()); ++i) {
+      if (working.count(i)) continue;
+      const Eigen::MatrixXd L = relaxation.localizing_matrix(candidates[i], y);
+      double min_eig;
+      if (L.rows() == 1) {
+        min_eig = L(0, 0);
+      } else {
+        Eigen::LLT<Eigen::MatrixXd> llt(L);
+        if (llt.info() == Eigen::Success) continue;  // positive definite: satisfied
+        min_eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(L, Eigen::EigenvaluesOnly).eigenvalues()(0);
+      }
+      const double rel = -min_eig / std::max(1.0, L.cwiseAbs().maxCoeff());
+      worst = std::max(worst, rel);
+      if (rel > options.violation_tolerance) violated.push_back({rel, i});
+    }
+    result.max_violation = worst;
+    if (on_round) on_round(result.working_set);
+    if (violated.empty()) {
+      result.tight = true;
+      result.message = fmt::format("tight: {} rounds, {} of {} data constraints in the LMI, none of the others violated",
+                                   round, working.size(), candidates.size());
+      return result;
+    }
+    std::sort(violated.rbegin(), violated.rend());
+    for (int k = 0; k < std::min<int>(options.add_per_round, violated.size()); ++k) working.insert(violated[k].second);
+  }
+  result.message = fmt::format("round limit reached: the bound is valid but may be looser than the full relaxation's "
+                               "(max relative violation {:.2e})",
+                               result.max_violation);
+  return result;
+}
+
+sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constraints, int num_vars,
+                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver) {
+  int D = 1;
+  for (const auto& g : constraints) D = std::max(D, g.degree());
+  const MonomialBasis basis(num_vars, D);
+  const int m = static_cast<int>(basis.size()) - 1;
+  std::vector<int> even;
+  for (int i = 1; i <= m; ++i) {
+    bool all_even = true;
+    for (auto e : basis[i]) all_even = all_even && e % 2 == 0;
+    if (all_even) even.push_back(i);
+  }
+  const int rows = static_cast<int>(constraints.size()) + 2 * m + static_cast<int>(even.size());
+  sdp::LmiProblem lp;
+  lp.blocks.push_back({sdp::BlockSpec::Kind::kDiagonal, rows});
+  lp.c.assign(m, 0.0);  // feasibility problem
+  lp.F.assign(m + 1, {});
+  int r = 0;
+  for (const auto& g : constraints) {
+    for (const auto& [e, coef] : g.terms()) {
+      const long k = basis.index_of(e);
+      if (k == 0)
+        lp.F[0].push_back({0, r, r, -coef});
+      else
+        lp.F[k].push_back({0, r, r, coef});
+    }
+    ++r;
+  }
+  for (int k = 1; k <= m; ++k) {  // 1 - y >= 0 and 1 + y >= 0
+    lp.F[0].push_back({0, r, r, -1.0});
+    lp.F[k].push_back({0, r, r, -1.0});
+    ++r;
+    lp.F[0].push_back({0, r, r, -1.0});
+    lp.F[k].push_back({0, r, r, 1.0});
+    ++r;
+  }
+  for (int k : even) {
+    lp.F[k].push_back({0, r, r, 1.0});
+    ++r;
+  }
+  return solver.Solve(options, lp);
+}
+
+}  // namespace hw::relax
