@@ -8,6 +8,7 @@ namespace hw::cli {
 
 void AddSimulateCommand(CLI::App& app);
 void AddPopCommand(CLI::App& app);
+void AddBoundsCommand(CLI::App& app);
 // Further commands are declared here as their modules land (bounds, brouri, esmaeilani, diagnose, compare).
 
 }  // namespace hw::cli

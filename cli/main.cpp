@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   CLI::App app{"hwbounds: set-membership bounds, estimators and diagnosis for Hammerstein-Wiener systems"};
   app.require_subcommand(1);
   hw::cli::AddSimulateCommand(app);
+  hw::cli::AddBoundsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

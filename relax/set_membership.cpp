@@ -1,0 +1,495 @@
+#include "relax/set_membership.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+
+namespace hw::relax {
+namespace fs = std::filesystem;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// One objective: min (dir = -1) or max (dir = +1) of parameter k.
+struct Objective {
+  int param;
+  int dir;
+};
+
+struct JobOutcome {
+  std::string status;  // "solved", "infeasible", "failed"
+  double bound = 0.0;  // in original units
+  bool tight = false;
+  std::string message;
+  int rounds = 0;
+  int sdp_iterations = 0;
+  double seconds = 0.0;
+  std::size_t moments = 0, blocks = 0;
+  std::vector<int> working_set;
+  nlohmann::json to_json() const {
+    return {{"status", status}, {"bound", bound}, {"tight", tight}, {"message", message}, {"rounds", rounds},
+            {"sdp_iterations", sdp_iterations}, {"seconds", seconds}, {"moments", moments}, {"blocks", blocks},
+            {"working_set", working_set}};
+  }
+  static JobOutcome from_json(const nlohmann::json& j) {
+    JobOutcome o;
+    o.status = j.at("status");
+    o.bound = j.at("bound");
+    o.tight = j.at("tight");
+    o.message = j.at("message");
+    o.rounds = j.at("rounds");
+    o.sdp_iterations = j.value("sdp_iterations", 0);
+    o.seconds = j.at("seconds");
+    o.moments = j.at("moments");
+    o.blocks = j.at("blocks");
+    o.working_set = j.at("working_set").get<std::vector<int>>();
+    return o;
+  }
+};
+
+// Runs fn(i) for i in [0, n) on `threads` threads; reports progress after each job.
+void parallel_for(int threads, int n, const std::function<void(int)>& fn, const std::function<void(int)>& on_done) {
+  std::atomic<int> next{0}, done{0};
+  std::mutex report;
+  std::exception_ptr failure;
+  auto worker = [&] {
+    for (int i; (i = next++) < n;) {
+      try {
+        fn(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(report);
+        if (!failure) failure = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(report);
+      if (on_done) on_done(++done);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < std::max(1, std::min(threads, n)); ++t) pool.emplace_back(worker);
+  for (auto& th : pool) th.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+uint64_t fnv(uint64_t h, const void* data, std::size_t n) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+// Cache of finished jobs and per-orthant working sets in run_dir/<problem hash>/.
+class RunCache {
+ public:
+  RunCache(const std::string& root, const std::string& key, const nlohmann::json& meta) {
+    if (root.empty()) return;
+    dir_ = fs::path(root) / key;
+    fs::create_directories(dir_ / "jobs");
+    if (!fs::exists(dir_ / "problem.json")) write_text_atomic((dir_ / "problem.json").string(), meta.dump(2));
+  }
+  bool enabled() const { return !dir_.empty(); }
+  std::string path() const { return dir_.string(); }
+  std::optional<nlohmann::json> load(const std::string& name) const {
+    if (!enabled()) return std::nullopt;
+    std::ifstream in(dir_ / "jobs" / (name + ".json"));
+    if (!in) return std::nullopt;
+    try {
+      nlohmann::json j;
+      in >> j;
+      return j;
+    } catch (...) {
+      return std::nullopt;  // a damaged file is recomputed, never trusted
+    }
+  }
+  void store(const std::string& name, const nlohmann::json& j) const {
+    if (enabled()) write_text_atomic((dir_ / "jobs" / (name + ".json")).string(), j.dump());
+  }
+
+ private:
+  fs::path dir_;
+};
+
+std::string sign_text(const HwOuterSet& set, int l) {
+  std::string s;
+  const auto signs = set.orthant_signs(l);
+  for (std::size_t k = 0; k < signs.size(); ++k)
+    s += fmt::format("{}{}{}", k ? " " : "", set.sign_names()[k], signs[k] > 0 ? "+" : "-");
+  return s;
+}
+
+}  // namespace
+
+bool BoundsOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  if (order < 1) return fail("order must be >= 1");
+  if (threads < 0) return fail("threads must be >= 0");
+  if (solver != "csdp" && solver != "sdpa") return fail(fmt::format("solver '{}' unknown; expected csdp or sdpa", solver));
+  ConstraintGenerationOptions g = generation;
+  return g.IsValid(error);
+}
+
+bool BoundsSummary::all_guaranteed() const {
+  for (const auto& iv : intervals)
+    if (iv.lower.status != "guaranteed" || iv.upper.status != "guaranteed") return false;
+  return true;
+}
+
+nlohmann::json BoundsSummary::to_json() const {
+  nlohmann::json j;
+  j["order"] = order;
+  j["horizon"] = horizon;
+  j["solver"] = solver;
+  nlohmann::json box_j = nlohmann::json::array();
+  for (std::size_t i = 0; i < box.size(); ++i)
+    box_j.push_back({{"parameter", parameter_names[i]}, {"lo", box[i].first}, {"hi", box[i].second}});
+  j["prior_box"] = box_j;
+  j["prior_box_note"] = "intervals are guaranteed for parameters inside this box (a prior assumption)";
+  auto ep = [](const Endpoint& e) {
+    return nlohmann::json{{"value", e.value}, {"status", e.status}, {"note", e.note}, {"orthant", e.orthant},
+                          {"tight", e.tight}};
+  };
+  for (const auto& iv : intervals)
+    j["intervals"].push_back({{"parameter", iv.name}, {"lower", ep(iv.lower)}, {"upper", ep(iv.upper)},
+                              {"half_width", iv.half_width()}});
+  for (const auto& o : orthants) j["orthants"].push_back({{"index", o.index}, {"signs", o.signs}, {"status", o.status}});
+  j["counts"] = {{"orthants_total", orthants_total}, {"orthants_proven_empty", orthants_empty},
+                 {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
+                 {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache}};
+  j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds}};
+  j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
+  j["all_guaranteed"] = all_guaranteed();
+  return j;
+}
+
+BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
+                            const std::function<void(const BoundsProgress&)>& progress) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError("bounds options: " + error);
+  const auto t0 = Clock::now();
+  const int n = set.num_vars();
+  const int L = set.num_orthants();
+  const int threads = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  int min_order = 1;
+  std::vector<std::vector<DataConstraint>> data(L);  // built lazily per orthant
+  {
+    // Minimal order from the constraint degrees: Remark 3, ceil((n + 1) / 2), and >= 1 for the box.
+    min_order = std::max(1, (set.horizon() + 2) / 2);
+  }
+  if (options.order < min_order)
+    throw InputError(fmt::format("order {} is below the minimal order {} for horizon {}", options.order, min_order,
+                                 set.horizon()));
+
+  // Problem hash for the run directory: everything that changes the numbers.
+  nlohmann::json meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
+                         {"solver", options.solver}, {"box", set.box()},
+                         {"violation_tolerance", options.generation.violation_tolerance},
+                         {"gap_tolerance", options.generation.sdp.gap_tolerance}};
+  uint64_t h = 1469598103934665603ull;
+  const std::string meta_text = meta.dump();
+  h = fnv(h, meta_text.data(), meta_text.size());
+  for (int l = 0; l < std::min(L, 1); ++l)
+    for (const auto& c : set.data_constraints(l)) {
+      const std::string t = c.g.to_string();
+      h = fnv(h, t.data(), t.size());
+    }
+  const RunCache cache(options.run_dir, fmt::format("{:016x}", h), meta);
+
+  BoundsSummary summary;
+  summary.order = options.order;
+  summary.horizon = set.horizon();
+  summary.solver = options.solver;
+  summary.box = set.box();
+  summary.parameter_names = set.layout().names;
+  summary.orthants_total = L;
+
+  std::mutex mu;
+  std::vector<double> solve_times;
+  std::vector<std::string> orthant_status(L, "undecided");
+  std::vector<std::set<int>> working(L);
+  std::vector<std::vector<Polynomial>> candidates(L);
+  std::vector<std::once_flag> built(L);
+  auto candidates_of = [&](int l) -> const std::vector<Polynomial>& {
+    std::call_once(built[l], [&] {
+      for (auto& c : set.data_constraints(l)) candidates[l].push_back(std::move(c.g));
+    });
+    return candidates[l];
+  };
+  auto report = [&](const std::string& phase, int done, int total) {
+    if (!progress) return;
+    const double el = seconds_since(t0);
+    progress({phase, done, total, el, done > 0 ? el / done * (total - done) : 0.0});
+  };
+
+  // 1. LP screen.
+  std::vector<int> alive;
+  for (int l = 0; l < L; ++l) alive.push_back(l);
+  if (options.lp_screen) {
+    std::vector<char> empty(L, 0);
+    const auto t_phase = Clock::now();
+    parallel_for(
+        threads, L,
+        [&](int l) {
+          const std::string key = fmt::format("lp_l{}", l);
+          if (auto j = cache.load(key)) {
+            empty[l] = j->at("empty").get<bool>();
+            std::lock_guard<std::mutex> lock(mu);
+            ++summary.jobs_from_cache;
+            return;
+          }
+          std::vector<Polynomial> cons = set.sign_constraints(l);
+          for (const auto& g : candidates_of(l)) cons.push_back(g);
+          auto solver = sdp::MakeSolver(options.solver);
+          sdp::SdpOptions lp_options = options.generation.sdp;
+          lp_options.keep_dual_matrix = false;
+          const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver);
+          empty[l] = s.status == sdp::SdpStatus::kInfeasible;
+          cache.store(key, {{"empty", static_cast<bool>(empty[l])}, {"status", sdp::ToString(s.status)}});
+        },
+        [&](int done) {
+          (void)t_phase;
+          report("LP screen of orthants", done, L);
+        });
+    alive.clear();
+    for (int l = 0; l < L; ++l) {
+      if (empty[l]) {
+        orthant_status[l] = "empty (LP)";
+      } else {
+        alive.push_back(l);
+      }
+    }
+  }
+
+  // Objectives: min and max of every parameter.
+  std::vector<Objective> objectives;
+  for (int k = 0; k < n; ++k) {
+    objectives.push_back({k, -1});
+    objectives.push_back({k, +1});
+  }
+  const int num_obj = static_cast<int>(objectives.size());
+
+  // One relaxation job: orthant l, objective o, order d.
+  auto run_job = [&](int l, int o, int d) -> JobOutcome {
+    const Objective obj = objectives[o];
+    const std::string key = fmt::format("o{}_l{}_{}_{}", d, l, set.layout().names[obj.param], obj.dir < 0 ? "min" : "max");
+    if (auto j = cache.load(key)) {
+      auto out = JobOutcome::from_json(*j);
+      std::lock_guard<std::mutex> lock(mu);
+      ++summary.jobs_from_cache;
+      working[l].insert(out.working_set.begin(), out.working_set.end());
+      return out;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      if (orthant_status[l].rfind("empty", 0) == 0) return {"infeasible", 0, false, "orthant already proven empty"};
+    }
+    PolyProblem core;
+    core.num_vars = n;
+    core.objective = Polynomial::Variable(n, obj.param);
+    core.maximize = obj.dir > 0;
+    core.inequalities = set.box_constraints();
+    for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(std::move(g));
+    std::vector<int> initial;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      initial.assign(working[l].begin(), working[l].end());
+    }
+    ConstraintGenerationOptions gen = options.generation;
+    gen.order = d;
+    auto solver = sdp::MakeSolver(options.solver);
+    const auto r = SolveWithConstraintGeneration(gen, core, candidates_of(l), initial, *solver,
+                                                 [&](const std::vector<int>& ws) {
+                                                   std::lock_guard<std::mutex> lock(mu);
+                                                   working[l].insert(ws.begin(), ws.end());
+                                                 });
+    JobOutcome out;
+    out.rounds = r.rounds;
+    out.sdp_iterations = r.sdp_iterations;
+    out.seconds = r.solve_seconds;
+    out.moments = r.num_moments;
+    out.blocks = r.num_blocks;
+    out.working_set = r.working_set;
+    out.message = r.message;
+    out.tight = r.tight;
+    if (r.status == RelaxationStatus::kInfeasible) {
+      out.status = "infeasible";
+    } else if (r.status == RelaxationStatus::kSolved) {
+      out.status = "solved";
+      out.bound = set.scaling().to_original(obj.param, r.bound);
+    } else {
+      out.status = "failed";
+    }
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      ++summary.sdp_jobs;
+      summary.sdp_solves += r.rounds;
+      solve_times.push_back(r.rounds ? r.solve_seconds / r.rounds : 0.0);
+      summary.largest_moments = std::max(summary.largest_moments, r.num_moments);
+      summary.largest_blocks = std::max(summary.largest_blocks, r.num_blocks);
+      if (out.status == "infeasible") orthant_status[l] = fmt::format("empty (order {})", d);
+    }
+    cache.store(key, out.to_json());
+    return out;
+  };
+
+  // 2. Cheap pass at the minimal order (also the final pass when order == minimal).
+  const int cheap_order = options.cheap_pass ? min_order : options.order;
+  std::map<std::pair<int, int>, JobOutcome> cheap;  // (orthant, objective)
+  {
+    std::vector<std::pair<int, int>> jobs;
+    for (int l : alive)
+      for (int o = 0; o < num_obj; ++o) jobs.push_back({l, o});
+    std::vector<JobOutcome> outs(jobs.size());
+    parallel_for(
+        threads, static_cast<int>(jobs.size()),
+        [&](int i) { outs[i] = run_job(jobs[i].first, jobs[i].second, cheap_order); },
+        [&](int done) { report(fmt::format("order {} relaxations", cheap_order), done, static_cast<int>(jobs.size())); });
+    for (std::size_t i = 0; i < jobs.size(); ++i) cheap[jobs[i]] = outs[i];
+  }
+  auto is_empty = [&](int l) { return orthant_status[l].rfind("empty", 0) == 0; };
+
+  // 3. Full pass: per objective, orthants by cheap bound (most extreme first), skipped when unable to move it.
+  std::map<std::pair<int, int>, JobOutcome> full = cheap;
+  if (options.order > cheap_order) {
+    full.clear();
+    // current[o] = aggregated endpoint from finished full-order jobs (min for dir -1, max for dir +1).
+    std::vector<double> current(num_obj, NAN);
+    std::set<std::pair<int, int>> done_jobs;
+    int total_est = 0;
+    for (int o = 0; o < num_obj; ++o)
+      for (int l : alive)
+        if (!is_empty(l)) ++total_est;
+    int finished = 0;
+    while (true) {
+      std::vector<std::pair<int, int>> wave;
+      for (int o = 0; o < num_obj; ++o) {
+        const int dir = objectives[o].dir;
+        int best = -1;
+        double best_val = 0.0;
+        for (int l : alive) {
+          if (is_empty(l) || done_jobs.count({l, o})) continue;
+          const auto& c = cheap.at({l, o});
+          // A failed cheap job cannot be used to skip: it must be solved.
+          const double v = c.status == "solved" ? c.bound : (dir < 0 ? -INFINITY : INFINITY);
+          const bool can_move = std::isnan(current[o]) || (dir < 0 ? v < current[o] : v > current[o]);
+          if (!can_move) continue;
+          if (best < 0 || (dir < 0 ? v < best_val : v > best_val)) {
+            best = l;
+            best_val = v;
+          }
+        }
+        if (best >= 0) wave.push_back({best, o});
+      }
+      if (wave.empty()) break;
+      std::vector<JobOutcome> outs(wave.size());
+      parallel_for(
+          threads, static_cast<int>(wave.size()),
+          [&](int i) { outs[i] = run_job(wave[i].first, wave[i].second, options.order); },
+          [&](int) { report(fmt::format("order {} relaxations", options.order), ++finished, total_est); });
+      for (std::size_t i = 0; i < wave.size(); ++i) {
+        const auto [l, o] = wave[i];
+        done_jobs.insert({l, o});
+        full[{l, o}] = outs[i];
+        if (outs[i].status == "solved") {
+          const int dir = objectives[o].dir;
+          if (std::isnan(current[o]) || (dir < 0 ? outs[i].bound < current[o] : outs[i].bound > current[o]))
+            current[o] = outs[i].bound;
+        }
+      }
+    }
+    // Orthants not solved at full order for an objective keep their cheap outcome (valid, and never more
+    // extreme than the aggregate, or they would have been solved).
+    for (int l : alive)
+      for (int o = 0; o < num_obj; ++o)
+        if (!full.count({l, o}) && !is_empty(l)) {
+          auto c = cheap.at({l, o});
+          c.message = "skipped at full order: its order-" + std::to_string(cheap_order) + " bound cannot move the interval";
+          c.status = c.status == "solved" ? "skipped" : c.status;
+          full[{l, o}] = c;
+        }
+  }
+
+  // 4. Aggregate (eqs. 31-33) with fallbacks.
+  for (int k = 0; k < n; ++k) {
+    ParameterInterval iv;
+    iv.name = set.layout().names[k];
+    for (int dir : {-1, +1}) {
+      const int o = 2 * k + (dir > 0 ? 1 : 0);
+      Endpoint ep;
+      ep.status = "empty";
+      bool any = false;
+      for (int l : alive) {
+        if (is_empty(l)) continue;
+        const auto& r = full.at({l, o});
+        double v;
+        std::string status = "guaranteed", note;
+        bool tight = r.tight;
+        if (r.status == "solved" || r.status == "skipped") {
+          v = r.bound;
+        } else if (r.status == "infeasible") {
+          continue;  // proven empty in this orthant
+        } else {
+          const auto& c = cheap.at({l, o});
+          if (c.status == "solved" && options.order > cheap_order) {
+            v = c.bound;
+            note = fmt::format("order-{} solve failed in orthant {} ({}); order-{} bound used", options.order, l,
+                               r.message, cheap_order);
+          } else {
+            v = dir < 0 ? set.box()[k].first : set.box()[k].second;
+            note = fmt::format("solve failed in orthant {} ({}); box edge used", l, r.message);
+          }
+          status = "conservative";
+          tight = false;
+        }
+        const bool better = !any || (dir < 0 ? v < ep.value : v > ep.value);
+        // The endpoint's status is that of the orthant attaining it: a fallback that is not extreme
+        // leaves the endpoint exact, since the fallback still bounds that orthant.
+        if (better) {
+          ep.value = v;
+          ep.orthant = l;
+          ep.tight = tight;
+          ep.status = status;
+        }
+        if (!note.empty()) ep.note += (ep.note.empty() ? "" : "; ") + note;
+        any = true;
+      }
+      if (!any) ep.note = "every orthant is proven empty: the data are inconsistent with the model class and box";
+      (dir < 0 ? iv.lower : iv.upper) = ep;
+    }
+    summary.intervals.push_back(iv);
+  }
+
+  for (int l = 0; l < L; ++l) {
+    bool failed = false;
+    if (!is_empty(l) && orthant_status[l] == "undecided") {
+      for (int o = 0; o < num_obj; ++o)
+        if (full.count({l, o}) && full.at({l, o}).status == "failed") failed = true;
+      orthant_status[l] = failed ? "failed (conservative fallback)" : "solved";
+    }
+    if (is_empty(l)) ++summary.orthants_empty;
+    else if (failed) ++summary.orthants_failed;
+    else ++summary.orthants_solved;
+    summary.orthants.push_back({l, sign_text(set, l), orthant_status[l]});
+  }
+  std::sort(solve_times.begin(), solve_times.end());
+  if (!solve_times.empty()) summary.median_solve_seconds = solve_times[solve_times.size() / 2];
+  summary.wall_seconds = seconds_since(t0);
+  return summary;
+}
+
+}  // namespace hw::relax
