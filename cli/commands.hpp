@@ -9,6 +9,8 @@ namespace hw::cli {
 void AddSimulateCommand(CLI::App& app);
 void AddPopCommand(CLI::App& app);
 void AddBoundsCommand(CLI::App& app);
+void AddDiagnoseCommand(CLI::App& app);
+void AddScenarioCommand(CLI::App& app);
 // Further commands are declared here as their modules land (bounds, brouri, esmaeilani, diagnose, compare).
 
 }  // namespace hw::cli

@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   hw::cli::AddSimulateCommand(app);
   hw::cli::AddBoundsCommand(app);
+  hw::cli::AddDiagnoseCommand(app);
+  hw::cli::AddScenarioCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

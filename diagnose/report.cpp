@@ -1,0 +1,229 @@
+// report.json, report.md and the gnuplot figures of a diagnosis.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+#include "diagnose/diagnose.hpp"
+
+namespace hw::diagnose {
+namespace {
+
+using Windows = std::vector<std::pair<std::size_t, std::size_t>>;
+
+nlohmann::json TimeWindows(const Windows& w, const std::vector<double>& t) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& [a, b] : w) j.push_back({t[a], t[b]});
+  return j;
+}
+
+nlohmann::json SampleWindows(const Windows& w) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& [a, b] : w) j.push_back({a, b});
+  return j;
+}
+
+std::string Verdict(const DiagnoseReport& r) {
+  return r.verdict == Effect::kNone ? "none"
+                                    : fmt::format("{} at {}", EffectName(r.verdict), LocationName(r.verdict_location));
+}
+
+// Plot data: one whitespace-separated file, '#' header so gnuplot skips it.
+void WriteSeries(const std::string& path, const std::vector<std::string>& names,
+                 const std::vector<const std::vector<double>*>& cols) {
+  std::ostringstream s;
+  s << "#";
+  for (const auto& n : names) s << " " << n;
+  s << "\n";
+  const std::size_t n = cols.front()->size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t c = 0; c < cols.size(); ++c) s << (c ? " " : "") << fmt::format("{:.9g}", (*cols[c])[i]);
+    s << "\n";
+  }
+  write_text_atomic(path, s.str());
+}
+
+std::string ShadeWindows(const Windows& w, const std::vector<double>& t) {
+  std::string s = "unset object\n";
+  const std::size_t limit = 400;  // gnuplot objects; enough for a readable figure
+  for (std::size_t i = 0; i < w.size() && i < limit; ++i)
+    s += fmt::format("set object {} rect from {:.9g}, graph 0 to {:.9g}, graph 1 behind fc rgb '#ffd8a8' fs solid 0.6 noborder\n",
+                     i + 1, t[w[i].first], t[w[i].second] + (t.size() > 1 ? t[1] - t[0] : 1.0));
+  return s;
+}
+
+}  // namespace
+
+nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const Recording& valid) {
+  nlohmann::json findings = nlohmann::json::array();
+  for (const auto& f : r.findings) findings.push_back(f.to_json());
+  std::size_t flagged = 0;
+  for (bool m : r.mask) flagged += m;
+  nlohmann::json j;
+  j["tool"] = "hwbounds diagnose";
+  j["schema_version"] = 1;
+  j["ok"] = r.ok;
+  j["verdict"] = EffectName(r.verdict);
+  j["verdict_location"] = r.verdict == Effect::kNone ? nlohmann::json(nullptr) : nlohmann::json(LocationName(r.verdict_location));
+  j["summary"] = r.message;
+  j["findings"] = findings;
+  j["mismatch"] = {
+      {"windows", TimeWindows(r.windows, ident.t)},
+      {"window_samples", SampleWindows(r.windows)},
+      {"flagged_fraction", r.mask.empty() ? 0.0 : double(flagged) / r.mask.size()},
+      {"validation_windows", TimeWindows(r.validation_windows, valid.t)},
+      {"region", r.region.to_json()},
+      {"noise_std", r.noise_std},
+      {"noise_std_source", r.noise_estimated ? "estimated (1.4826 MAD of residual differences / sqrt 2)" : "given"}};
+  nlohmann::json aug = r.augmented.to_json();
+  aug["effect"] = EffectName(r.augmented_model.block.effect);
+  j["fit"] = {{"nominal", r.nominal.to_json()},
+              {"nominal_refit", r.nominal_refit.to_json()},
+              {"augmented", aug},
+              {"on", "validation recording"},
+              {"validation_paired_z", r.validation_z},
+              {"note", r.validation_note},
+              {"identification", {{"nominal", r.ident_nominal.to_json()}, {"augmented", r.ident_augmented.to_json()}}}};
+  j["residual_tests"] = {
+      {"nominal_on_identification",
+       {{"whiteness", r.whiteness_nominal.to_json()}, {"input_cross_correlation", r.input_corr_nominal.to_json()}}},
+      {"augmented_on_validation",
+       {{"whiteness", r.whiteness_augmented.to_json()}, {"input_cross_correlation", r.input_corr_augmented.to_json()}}}};
+  j["models"] = {{"nominal", r.nominal_model.to_json()},
+                 {"nominal_refit", r.nominal_refit_model.to_json()},
+                 {"augmented", r.augmented_model.to_json()}};
+  j["data"] = {{"identification", {{"name", ident.name}, {"samples", ident.y.size()}}},
+               {"validation", {{"name", valid.name}, {"samples", valid.y.size()}}}};
+  j["run_time_seconds"] = r.seconds;
+  return j;
+}
+
+std::string ReportMarkdown(const DiagnoseReport& r, const Recording& ident, const Recording& valid) {
+  std::string s = "# Discrepancy diagnosis\n\n";
+  s += fmt::format("**Verdict: {}.** {}\n\n", Verdict(r), r.message);
+  s += fmt::format("Identification: `{}` ({} samples); validation: `{}` ({} samples). Run time {:.2f} s.\n\n",
+                   ident.name, ident.y.size(), valid.name, valid.y.size(), r.seconds);
+  s += "## Where the nominal model differs\n\n";
+  s += fmt::format("Noise standard deviation {:.4g} ({}). {} mismatch window(s) where the local mean-square error "
+                   "exceeds the noise; they are characterised by: **{}**.\n\n",
+                   r.noise_std, r.noise_estimated ? "estimated from the residual" : "given", r.windows.size(),
+                   r.region.description);
+  if (!r.windows.empty()) {
+    s += "First windows (t_start – t_end): ";
+    for (std::size_t i = 0; i < r.windows.size() && i < 12; ++i)
+      s += fmt::format("{}[{:.6g}, {:.6g}]", i ? ", " : "", ident.t[r.windows[i].first], ident.t[r.windows[i].second]);
+    s += r.windows.size() > 12 ? ", …\n\n" : "\n\n";
+  }
+  auto test_row = [](const std::string& name, const CorrelationTest& t) {
+    return fmt::format("| {} | {:.1f} | {} | {:.1f} | {} |\n", name, t.statistic, t.dof, t.threshold,
+                       t.passed ? "pass" : "fail");
+  };
+  s += "Residual tests (Ljung): N·Σρ² against the χ² 99 % quantile.\n\n| test | statistic | dof | threshold | result |\n|---|---|---|---|---|\n";
+  s += test_row("nominal, identification: whiteness", r.whiteness_nominal);
+  s += test_row("nominal, identification: cross-correlation with u", r.input_corr_nominal);
+  s += test_row("augmented, validation: whiteness", r.whiteness_augmented);
+  s += test_row("augmented, validation: cross-correlation with u", r.input_corr_augmented);
+  s += "\n## Candidate effects (ranked on the held-out tail of the identification recording)\n\n";
+  s += "| rank | effect | location | parameters | held-out MSE ratio | score | z | in windows | significant |\n";
+  s += "|---|---|---|---|---|---|---|---|---|\n";
+  int rank = 0;
+  for (const auto& f : r.findings) {
+    std::string p;
+    const auto names = ParameterNames(f.block.effect);
+    for (std::size_t i = 0; i < names.size(); ++i) p += fmt::format("{}{}={:.4g}", i ? ", " : "", names[i], f.block.params[i]);
+    s += fmt::format("| {} | {} | {} | {} | {:.3f} | {:.3f} | {:.1f} | {:.0f} % | {} |\n", ++rank,
+                     EffectName(f.block.effect), LocationName(f.block.location), p, f.mse_ratio, f.score, f.z,
+                     100 * f.in_window_share, f.significant ? "yes" : "no");
+  }
+  s += fmt::format("\n{}\n\n## Fit on the validation recording\n\n", r.validation_note);
+  s += "| model | RMSE | fit % |\n|---|---|---|\n";
+  s += fmt::format("| nominal (as given / fitted) | {:.5g} | {:.2f} |\n", r.nominal.rmse, r.nominal.fit_percent);
+  s += fmt::format("| nominal, linear part refitted | {:.5g} | {:.2f} |\n", r.nominal_refit.rmse, r.nominal_refit.fit_percent);
+  s += fmt::format("| augmented ({}) | {:.5g} | {:.2f} |\n\n", EffectName(r.augmented_model.block.effect), r.augmented.rmse,
+                   r.augmented.fit_percent);
+  s += "## Figures\n\n![identification](identification.png)\n\n![validation](validation.png)\n\n"
+       "![residual against the operating condition](residual_vs_condition.png)\n\n![residual in time](residual_time.png)\n";
+  return s;
+}
+
+std::vector<std::string> WriteReport(const DiagnoseReport& r, const Recording& ident, const Recording& valid,
+                                     const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", dir, ec.message()));
+  std::vector<std::string> written;
+  auto put = [&](const std::string& name, const std::string& text) {
+    write_text_atomic((fs::path(dir) / name).string(), text);
+    written.push_back((fs::path(dir) / name).string());
+  };
+  put("report.json", ReportJson(r, ident, valid).dump(2) + "\n");
+  put("report.md", ReportMarkdown(r, ident, valid));
+  put("nominal_model.json", r.nominal_model.to_json().dump(2) + "\n");
+  put("augmented_model.json", r.augmented_model.to_json().dump(2) + "\n");
+  if (!r.ok) return written;
+
+  // Plot data.
+  std::vector<double> e_nom(ident.y.size()), e_aug(ident.y.size());
+  for (std::size_t t = 0; t < ident.y.size(); ++t) {
+    e_nom[t] = ident.y[t] - r.ident_nominal_sim[t];
+    e_aug[t] = ident.y[t] - r.ident_augmented_sim[t];
+  }
+  const std::string p_ident = (fs::path(dir) / "identification.dat").string();
+  WriteSeries(p_ident, {"t", "y", "nominal", "augmented", "residual_nominal", "residual_augmented"},
+              {&ident.t, &ident.y, &r.ident_nominal_sim, &r.ident_augmented_sim, &e_nom, &e_aug});
+  const std::string p_valid = (fs::path(dir) / "validation.dat").string();
+  WriteSeries(p_valid, {"t", "y", "nominal", "augmented"},
+              {&valid.t, &valid.y, &r.valid_nominal_sim, &r.valid_augmented_sim});
+  written.push_back(p_ident);
+  written.push_back(p_valid);
+  const Condition* cond = nullptr;
+  for (const auto& c : r.conditions)
+    if (c.name == (r.region.found ? r.region.condition : std::string("u"))) cond = &c;
+  if (cond) {
+    const std::string p = (fs::path(dir) / "condition.dat").string();
+    WriteSeries(p, {cond->name, "residual_nominal", "residual_augmented"}, {&cond->values, &e_nom, &e_aug});
+    written.push_back(p);
+  }
+  const std::string verdict = Verdict(r);
+  std::string gp = "set terminal pngcairo size 1200,500 noenhanced\nset grid\nset key outside top center horizontal\n";
+  gp += ShadeWindows(r.windows, ident.t);
+  gp += fmt::format(
+      "set output 'identification.png'\nset title 'Identification recording: measured y, nominal and augmented ({}) "
+      "simulations; shaded = mismatch windows of the nominal model'\nset xlabel 't'\nset ylabel 'y'\n"
+      "plot 'identification.dat' u 1:2 w l lc rgb '#999999' t 'y measured', '' u 1:3 w l lw 1.5 lc rgb '#d62728' t "
+      "'nominal', '' u 1:4 w l lw 1.5 lc rgb '#1f77b4' t 'augmented'\n",
+      verdict);
+  gp += fmt::format(
+      "set output 'residual_time.png'\nset title 'Simulation error on the identification recording (±3 sigma "
+      "noise band)'\nset ylabel 'y - yhat'\nplot 'identification.dat' u 1:5 w l lc rgb '#d62728' t 'nominal', '' u "
+      "1:6 w l lc rgb '#1f77b4' t 'augmented', {0:.9g} w l dt 2 lc rgb 'black' t '+3 sigma', -{0:.9g} w l dt 2 lc "
+      "rgb 'black' t '-3 sigma'\n",
+      3 * r.noise_std);
+  gp += ShadeWindows(r.validation_windows, valid.t);
+  gp += "set output 'validation.png'\nset title 'Validation recording: measured y, nominal and augmented "
+        "simulations; shaded = where the nominal model exceeds the noise'\nset ylabel 'y'\n"
+        "plot 'validation.dat' u 1:2 w l lc rgb '#999999' t 'y measured', '' u 1:3 w l lw 1.5 lc rgb '#d62728' t "
+        "'nominal', '' u 1:4 w l lw 1.5 lc rgb '#1f77b4' t 'augmented'\n";
+  if (cond) {
+    gp += "unset object\n";
+    gp += fmt::format(
+        "set output 'residual_vs_condition.png'\nset title 'Simulation error against {} (region: {})'\n"
+        "set xlabel '{}'\nset ylabel 'y - yhat'\n{}plot 'condition.dat' u 1:2 w p pt 7 ps 0.4 lc rgb '#d62728' t "
+        "'nominal', '' u 1:3 w p pt 7 ps 0.4 lc rgb '#1f77b4' t 'augmented'\n",
+        cond->words, r.region.found ? r.region.relation + " " + fmt::format("{:.4g}", r.region.threshold) : "none",
+        cond->words, r.region.found ? fmt::format("set arrow from {0:.9g}, graph 0 to {0:.9g}, graph 1 nohead dt 2\n", r.region.threshold) : "");
+  }
+  put("plots.gp", gp);
+  const std::string cmd = fmt::format("cd '{}' && gnuplot plots.gp > gnuplot.log 2>&1", dir);
+  if (std::system(cmd.c_str()) == 0) {
+    for (const char* f : {"identification.png", "residual_time.png", "validation.png", "residual_vs_condition.png"})
+      if (fs::exists(fs::path(dir) / f)) written.push_back((fs::path(dir) / f).string());
+  }
+  return written;
+}
+
+}  // namespace hw::diagnose

@@ -1,0 +1,268 @@
+#include "diagnose/residual_analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+
+namespace hw::diagnose {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (v.size() - 1))];
+}
+
+std::vector<double> SinceReversal(const std::vector<double>& s) {
+  const std::size_t n = s.size();
+  std::vector<double> out(n, 0.0);
+  double scale = 0.0;
+  for (std::size_t t = 1; t < n; ++t) scale = std::max(scale, std::abs(s[t] - s[t - 1]));
+  const double tiny = 1e-9 * scale;
+  int dir = 0;
+  long last = -static_cast<long>(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    if (t > 0) {
+      const double d = s[t] - s[t - 1];
+      const int nd = d > tiny ? 1 : (d < -tiny ? -1 : 0);
+      if (nd != 0 && dir != 0 && nd != dir) last = static_cast<long>(t);
+      if (nd != 0) dir = nd;
+    }
+    out[t] = static_cast<double>(std::min<long>(static_cast<long>(t) - last, static_cast<long>(n)));
+  }
+  return out;
+}
+
+std::string Num(double v) { return fmt::format("{:.4g}", v); }
+
+}  // namespace
+
+double EstimateNoiseStd(const std::vector<double>& e, std::size_t skip) {
+  std::vector<double> d;
+  for (std::size_t t = skip + 1; t < e.size(); ++t) d.push_back(e[t] - e[t - 1]);
+  if (d.empty()) return 0.0;
+  const double med = Median(d);
+  for (auto& v : d) v = std::abs(v - med);
+  return 1.4826 * Median(d) / std::sqrt(2.0);
+}
+
+bool WindowOptions::IsValid(std::string* error) const {
+  if (length < 0 || length == 1 || !(z > 0)) {
+    if (error) *error = "window length must be 0 (auto) or >= 2, and z > 0";
+    return false;
+  }
+  return true;
+}
+
+int WindowOptions::Resolve(std::size_t n) const {
+  if (length > 0) return length;
+  return std::clamp(static_cast<int>(n / 200), 8, 40);
+}
+
+std::vector<bool> MismatchMask(const std::vector<double>& e, double sigma, std::size_t skip, const WindowOptions& o) {
+  const std::size_t n = e.size();
+  const int L = o.Resolve(n);
+  std::vector<bool> mask(n, false);
+  if (n < skip + L || !(sigma > 0)) return mask;
+  const double thr = sigma * sigma * (1.0 + o.z * std::sqrt(2.0 / L));
+  std::vector<double> cs(n + 1, 0.0);
+  for (std::size_t t = 0; t < n; ++t) cs[t + 1] = cs[t] + (t >= skip ? e[t] * e[t] : 0.0);
+  for (std::size_t s = skip; s + L <= n; ++s) {
+    if ((cs[s + L] - cs[s]) / L > thr)
+      for (std::size_t t = s; t < s + L; ++t) mask[t] = true;
+  }
+  return mask;
+}
+
+std::vector<std::pair<std::size_t, std::size_t>> MaskToWindows(const std::vector<bool>& mask) {
+  std::vector<std::pair<std::size_t, std::size_t>> w;
+  for (std::size_t t = 0; t < mask.size(); ++t) {
+    if (!mask[t]) continue;
+    std::size_t e = t;
+    while (e + 1 < mask.size() && mask[e + 1]) ++e;
+    w.emplace_back(t, e);
+    t = e;
+  }
+  return w;
+}
+
+std::vector<Condition> OperatingConditions(const std::vector<double>& u, const std::vector<double>& y) {
+  const std::size_t n = u.size();
+  std::vector<Condition> c;
+  auto diff = [&](const std::vector<double>& s) {
+    std::vector<double> d(n, 0.0);
+    for (std::size_t t = 1; t < n; ++t) d[t] = s[t] - s[t - 1];
+    return d;
+  };
+  auto absv = [](std::vector<double> s) {
+    for (auto& v : s) v = std::abs(v);
+    return s;
+  };
+  const auto du = diff(u), dy = diff(y);
+  c.push_back({"u", "input level u", u});
+  c.push_back({"abs_u", "input magnitude |u|", absv(u)});
+  c.push_back({"y", "output level y (model)", y});
+  c.push_back({"abs_y", "output magnitude |y| (model)", absv(y)});
+  c.push_back({"du", "input rate du = u_t - u_{t-1}", du});
+  c.push_back({"abs_du", "input rate magnitude |du|", absv(du)});
+  c.push_back({"dy", "output rate dy (model)", dy});
+  c.push_back({"abs_dy", "output rate magnitude |dy| (model)", absv(dy)});
+  c.push_back({"since_rev_u", "samples since the last reversal of u", SinceReversal(u)});
+  c.push_back({"since_rev_y", "samples since the last reversal of y (model)", SinceReversal(y)});
+  return c;
+}
+
+nlohmann::json Region::to_json() const {
+  if (!found) return {{"description", description}, {"condition", nullptr}};
+  return {{"description", description}, {"condition", condition}, {"relation", relation},
+          {"threshold", threshold},     {"precision", precision}, {"recall", recall},
+          {"error_lift", lift}};
+}
+
+Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::vector<bool>& mask,
+                          const std::vector<double>& e, std::size_t skip) {
+  Region best;
+  best.description = "none: the error stays within the noise everywhere";
+  std::size_t nmask = 0;
+  for (std::size_t t = skip; t < mask.size(); ++t) nmask += mask[t];
+  if (nmask == 0) return best;
+  double best_score = -1.0;
+  for (const auto& c : conditions) {
+    std::vector<double> vals(c.values.begin() + std::min(skip, c.values.size()), c.values.end());
+    std::vector<double> ths;
+    for (int i = 1; i < 40; ++i) ths.push_back(Quantile(vals, i / 40.0));
+    std::sort(ths.begin(), ths.end());
+    ths.erase(std::unique(ths.begin(), ths.end()), ths.end());
+    for (double th : ths) {
+      for (int above = 0; above < 2; ++above) {
+        std::size_t tp = 0, sel = 0;
+        double e_in = 0.0, e_out = 0.0;
+        std::size_t n_in = 0, n_out = 0;
+        for (std::size_t t = skip; t < mask.size(); ++t) {
+          const bool r = above ? c.values[t] > th : c.values[t] <= th;
+          if (r) {
+            ++sel;
+            tp += mask[t];
+            e_in += e[t] * e[t];
+            ++n_in;
+          } else {
+            e_out += e[t] * e[t];
+            ++n_out;
+          }
+        }
+        if (sel == 0 || n_out == 0) continue;
+        const double prec = double(tp) / sel, rec = double(tp) / nmask;
+        const double f1 = prec + rec > 0 ? 2 * prec * rec / (prec + rec) : 0.0;
+        const double lift = (e_in / n_in) / std::max(e_out / n_out, 1e-300);
+        if (f1 > best_score && lift > 1.0) {
+          best_score = f1;
+          best.found = true;
+          best.condition = c.name;
+          best.relation = above ? "above" : "below";
+          best.threshold = th;
+          best.precision = prec;
+          best.recall = rec;
+          best.lift = lift;
+        }
+      }
+    }
+  }
+  if (!best.found) {
+    best.description = "no single operating condition characterises the mismatch windows";
+    return best;
+  }
+  const bool above = best.relation == "above";
+  const std::string th = Num(best.threshold);
+  const std::string& n = best.condition;
+  std::string d;
+  if (n == "since_rev_u" || n == "since_rev_y") {
+    const std::string sig = n == "since_rev_u" ? "u" : "y";
+    d = above ? fmt::format("more than {} samples after a reversal of {}", th, sig)
+              : fmt::format("within {} samples after a reversal of {}", th, sig);
+  } else {
+    static const std::map<std::string, std::string> label = {
+        {"u", "u"},     {"abs_u", "|u|"}, {"y", "y"},         {"abs_y", "|y|"},
+        {"du", "du/dt (per sample)"}, {"abs_du", "|du| per sample"}, {"dy", "dy (per sample)"},
+        {"abs_dy", "|dy| per sample"}};
+    d = fmt::format("{} {} {}", label.count(n) ? label.at(n) : n, above ? "above" : "at or below", th);
+  }
+  best.description = fmt::format("{} (covers {:.0f} % of the mismatch samples; {:.0f} % of the samples meeting it "
+                                 "are mismatched; error there {:.1f}x elsewhere)",
+                                 d, 100 * best.recall, 100 * best.precision, best.lift);
+  return best;
+}
+
+double ChiSquareQuantile(double p, int k) {
+  // Acklam-free normal quantile via a rational approximation good to 1e-3, enough for a test threshold.
+  auto norm_q = [](double q) {
+    const double t = std::sqrt(-2.0 * std::log(q < 0.5 ? q : 1 - q));
+    const double z = t - (2.515517 + 0.802853 * t + 0.010328 * t * t) /
+                             (1 + 1.432788 * t + 0.189269 * t * t + 0.001308 * t * t * t);
+    return q < 0.5 ? -z : z;
+  };
+  const double z = norm_q(p);
+  const double h = 2.0 / (9.0 * k);
+  return k * std::pow(1 - h + z * std::sqrt(h), 3);
+}
+
+nlohmann::json CorrelationTest::to_json() const {
+  return {{"statistic", statistic}, {"dof", dof}, {"threshold_99", threshold}, {"passed", passed}};
+}
+
+CorrelationTest WhitenessTest(const std::vector<double>& e, std::size_t skip, int M) {
+  CorrelationTest r;
+  const std::size_t n = e.size() > skip ? e.size() - skip : 0;
+  if (n <= static_cast<std::size_t>(M) + 2) return r;
+  double mean = 0.0;
+  for (std::size_t t = skip; t < e.size(); ++t) mean += e[t];
+  mean /= n;
+  auto R = [&](int lag) {
+    double s = 0.0;
+    for (std::size_t t = skip + lag; t < e.size(); ++t) s += (e[t] - mean) * (e[t - lag] - mean);
+    return s / n;
+  };
+  const double r0 = std::max(R(0), 1e-300);
+  for (int k = 1; k <= M; ++k) {
+    r.rho.push_back(R(k) / r0);
+    r.statistic += n * r.rho.back() * r.rho.back();
+  }
+  r.dof = M;
+  r.threshold = ChiSquareQuantile(0.99, M);
+  r.passed = r.statistic <= r.threshold;
+  return r;
+}
+
+CorrelationTest InputCorrelationTest(const std::vector<double>& e, const std::vector<double>& u, std::size_t skip,
+                                     int M) {
+  CorrelationTest r;
+  const std::size_t n = e.size() > skip ? e.size() - skip : 0;
+  if (n <= static_cast<std::size_t>(M) + 2) return r;
+  double me = 0.0, mu = 0.0;
+  for (std::size_t t = skip; t < e.size(); ++t) me += e[t], mu += u[t];
+  me /= n;
+  mu /= n;
+  double see = 0.0, suu = 0.0;
+  for (std::size_t t = skip; t < e.size(); ++t) see += (e[t] - me) * (e[t] - me), suu += (u[t] - mu) * (u[t] - mu);
+  const double norm = std::sqrt(std::max(see * suu, 1e-300));
+  for (int k = 0; k <= M; ++k) {
+    double s = 0.0;
+    for (std::size_t t = skip + k; t < e.size(); ++t) s += (e[t] - me) * (u[t - k] - mu);
+    r.rho.push_back(s / norm);
+    r.statistic += n * r.rho.back() * r.rho.back();
+  }
+  r.dof = M + 1;
+  r.threshold = ChiSquareQuantile(0.99, M + 1);
+  r.passed = r.statistic <= r.threshold;
+  return r;
+}
+
+}  // namespace hw::diagnose
