@@ -1,0 +1,299 @@
+#include "estimators/brouri/nonlinear_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+
+namespace hw::brouri {
+
+std::vector<HoldAverage> AverageHolds(const std::vector<double>& y, const std::vector<double>& levels,
+                                      int hold_samples, int average_samples) {
+  if (average_samples < 2 || average_samples > hold_samples)
+    throw InputError(fmt::format("averaging length M = {} must be in [2, hold length {}]", average_samples,
+                                 hold_samples));
+  const std::size_t needed = levels.size() * static_cast<std::size_t>(hold_samples);
+  if (y.size() < needed)
+    throw InputError(fmt::format("recording has {} samples, the {} holds of {} samples need {}", y.size(),
+                                 levels.size(), hold_samples, needed));
+  std::vector<HoldAverage> out;
+  for (std::size_t j = 0; j < levels.size(); ++j) {
+    const std::size_t end = (j + 1) * static_cast<std::size_t>(hold_samples);
+    const std::size_t begin = end - static_cast<std::size_t>(average_samples);
+    double mean = 0.0;
+    for (std::size_t i = begin; i < end; ++i) mean += y[i];
+    mean /= average_samples;
+    double ss = 0.0;
+    for (std::size_t i = begin; i < end; ++i) ss += (y[i] - mean) * (y[i] - mean);
+    const double sd = std::sqrt(ss / (average_samples - 1));
+    out.push_back({levels[j], mean, sd / std::sqrt(static_cast<double>(average_samples)), average_samples});
+  }
+  return out;
+}
+
+bool NonlinearOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  if (degree < 0 || degree > 15) return fail(fmt::format("degree p = {} must be in [1, 15] (0 = select)", degree));
+  if (max_degree < 1 || max_degree > 15) return fail(fmt::format("max degree {} must be in [1, 15]", max_degree));
+  if (!(plateau_sigmas > 0)) return fail("plateau_sigmas must be positive");
+  if (!(plateau_abs_tol >= 0)) return fail("plateau_abs_tol must be >= 0");
+  return true;
+}
+
+const char* ToString(DownBorderMethod m) {
+  switch (m) {
+    case DownBorderMethod::kPaperCoefficients: return "paper-coefficients";
+    case DownBorderMethod::kLeadingAndRoot: return "leading-and-root";
+    case DownBorderMethod::kRootAndSlope: return "root-and-slope";
+  }
+  return "?";
+}
+
+DownBorderMethod DownBorderMethodFromString(const std::string& name) {
+  for (auto m : {DownBorderMethod::kPaperCoefficients, DownBorderMethod::kLeadingAndRoot, DownBorderMethod::kRootAndSlope})
+    if (name == ToString(m)) return m;
+  throw InputError(fmt::format("descending-border method '{}' must be paper-coefficients, leading-and-root or "
+                               "root-and-slope",
+                               name));
+}
+
+namespace {
+
+// Number of leading holds whose output equals the reference hold's (the plateau, eqs. 7a/14a).
+int PlateauLength(const HoldAverage& ref, const std::vector<HoldAverage>& holds, const NonlinearOptions& o,
+                  double scale) {
+  int n = 0;
+  for (const auto& h : holds) {
+    const double tol = o.plateau_sigmas * std::hypot(h.std_error, ref.std_error) + o.plateau_abs_tol + 1e-6 * scale;
+    if (std::abs(h.mean - ref.mean) > tol) break;
+    ++n;
+  }
+  return n;
+}
+
+double FloorSe(double se, double scale) { return std::max(se, 1e-9 * scale + 1e-15); }
+
+// Chi-square acceptance of a degree-p fit: residuals no larger than the averaging noise explains.
+bool FitAccepted(const std::vector<double>& u, const std::vector<double>& x, const std::vector<double>& se, int p,
+                 double scale) {
+  const auto c = PolyFit(u, x, p);
+  double chi2 = 0.0;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const double r = (x[i] - PolyEval(c, u[i])) / FloorSe(se[i], scale);
+    chi2 += r * r;
+  }
+  const double dof = static_cast<double>(u.size()) - p - 1;
+  return chi2 <= dof + 4.0 * std::sqrt(2.0 * dof);
+}
+
+// The real root of q nearest the interval [lo, hi] (h^-1(0) = 0 makes it unique in the working range).
+double RootNearInterval(const std::vector<double>& q, double lo, double hi, const std::string& what,
+                        std::string* warnings) {
+  const auto roots = PolyRealRoots(q, 1e-6);
+  if (roots.empty())
+    throw InputError(fmt::format("{}: the fitted polynomial has no real root, so h(0) = 0 cannot place the border; "
+                                 "use levels that cross the border's zero or a lower degree",
+                                 what));
+  auto dist = [&](double r) { return r < lo ? lo - r : (r > hi ? r - hi : 0.0); };
+  const double mid = 0.5 * (lo + hi);
+  double best = roots.front();
+  int inside = 0;
+  for (double r : roots) {
+    if (dist(r) == 0.0) ++inside;
+    if (dist(r) < dist(best) || (dist(r) == dist(best) && std::abs(r - mid) < std::abs(best - mid))) best = r;
+  }
+  if (inside > 1 && warnings)
+    *warnings += fmt::format("{}: {} real roots inside the data range [{}, {}]; took {} (h should vanish only at 0). ",
+                             what, inside, lo, hi, best);
+  if (dist(best) > 0 && warnings)
+    *warnings += fmt::format("{}: root {} lies outside the data range [{}, {}] (extrapolated). ", what, best, lo, hi);
+  return best;
+}
+
+}  // namespace
+
+void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& reset,
+                            const std::vector<HoldAverage>& up, const std::vector<HoldAverage>& down,
+                            NonlinearEstimate* est, Summary* summary) {
+  *summary = {};
+  *est = {};
+  std::string err;
+  if (!options.IsValid(&err)) throw InputError(err);
+  for (std::size_t j = 1; j < up.size(); ++j)
+    if (!(up[j].level > up[j - 1].level)) throw InputError("ascending levels must increase strictly");
+  for (std::size_t j = 1; j < down.size(); ++j)
+    if (!(down[j].level < down[j - 1].level)) throw InputError("descending levels must decrease strictly");
+  if (up.empty() || down.empty()) throw InputError("both an ascending and a descending stage are needed");
+  if (!up.empty() && !(reset.level < up.front().level))
+    throw InputError(fmt::format("reset level {} must lie below the first ascending level {}", reset.level,
+                                 up.front().level));
+  double scale = std::abs(reset.mean);
+  for (const auto* v : {&up, &down})
+    for (const auto& h : *v) scale = std::max(scale, std::abs(h.mean));
+
+  est->reset = reset;
+  est->up = up;
+  est->down = down;
+  est->j_a = PlateauLength(reset, up, options, scale);
+  est->j_d = PlateauLength(up.back(), down, options, scale);
+
+  std::vector<double> ua, xa, sa, ud, xd;
+  for (std::size_t j = est->j_a; j < up.size(); ++j) ua.push_back(up[j].level), xa.push_back(up[j].mean),
+                                                     sa.push_back(up[j].std_error);
+  for (std::size_t j = est->j_d; j < down.size(); ++j) ud.push_back(down[j].level), xd.push_back(down[j].mean);
+  const int na = static_cast<int>(ua.size()), nd = static_cast<int>(ud.size());
+  if (na < 2)
+    throw InputError(fmt::format("ascending stage: only {} of {} levels lie on the ascending border (j_a = {}); "
+                                 "add levels above U = {}",
+                                 na, up.size(), est->j_a, up.back().level));
+
+  int p = options.degree;
+  if (p == 0) {
+    const int top = std::min(options.max_degree, na - 2);
+    for (int q = 1; q <= top && p == 0; ++q)
+      if (FitAccepted(ua, xa, sa, q, scale)) p = q;
+    if (p == 0) {
+      p = std::min(options.max_degree, na - 1);
+      est->warnings += fmt::format("degree selection: no degree up to {} explains the ascending points within the "
+                                   "noise; using p = {} (add levels or raise max_degree). ",
+                                   top, p);
+    }
+  }
+  est->degree = p;
+  if (na < p + 1)
+    throw InputError(fmt::format("ascending stage: degree p = {} needs N - j_a >= p + 1 = {} border levels (eq. 11), "
+                                 "got {} (j_a = {}); add levels above U = {}",
+                                 p, p + 1, na, est->j_a, up.back().level));
+  if (nd < p + 1)
+    throw InputError(fmt::format("descending stage: degree p = {} needs {} levels on the descending border, got {} "
+                                 "(j_d = {}); add levels below U = {}",
+                                 p, p + 1, nd, est->j_d, down.back().level));
+
+  // Ascending border: q_a(u) = h(u - d+), d+ its root, h(u) = q_a(u + d+) (eq. 12).
+  est->q_up = PolyFit(ua, xa, p);
+  const double d_up = RootNearInterval(est->q_up, ua.front(), ua.back(), "ascending border", &est->warnings);
+  est->h = PolyShift(est->q_up, d_up);
+  est->h[0] = 0.0;  // exactly, by construction of d+
+  const double lead_h = est->h[p];
+  if (lead_h == 0.0) throw InputError("estimated h has a zero leading coefficient; lower the degree");
+
+  // Descending border: q_d(u) = h(S^d (u - d-)).
+  est->q_down = PolyFit(ud, xd, p);
+  const double ratio = est->q_down[p] / lead_h;
+  if (!(ratio > 0))
+    throw InputError(fmt::format("descending fit's leading coefficient {} and h^'s {} have opposite signs, so "
+                                 "S^d = (ratio)^(1/p) is undefined; the descending levels do not lie on one border",
+                                 est->q_down[p], lead_h));
+  const double s_lead = std::pow(ratio, 1.0 / p);
+  // u^(p-1) coefficient of h(S(u - d)): c_p S^p p (-d) + c_{p-1} S^(p-1).
+  est->s_down_leading = s_lead;
+  est->d_down_coefficient =
+      (est->h[p - 1] * std::pow(s_lead, p - 1) - est->q_down[p - 1]) / (p * lead_h * std::pow(s_lead, p));
+  est->d_down_root = RootNearInterval(est->q_down, ud.back(), ud.front(), "descending border", &est->warnings);
+  // Slopes at the zero crossing: q_d'(d-) = S^d h'(0) and h'(0) = q_a'(d+); both fits have data there.
+  std::vector<double> dqd(p), dqa(p);
+  for (int i = 1; i <= p; ++i) dqd[i - 1] = i * est->q_down[i], dqa[i - 1] = i * est->q_up[i];
+  const double slope_h0 = PolyEval(dqa, d_up);
+  est->s_down_slope = slope_h0 != 0.0 ? PolyEval(dqd, est->d_down_root) / slope_h0 : s_lead;
+  double s_down = s_lead, d_down = est->d_down_coefficient;
+  if (options.down_border == DownBorderMethod::kLeadingAndRoot) d_down = est->d_down_root;
+  if (options.down_border == DownBorderMethod::kRootAndSlope) s_down = est->s_down_slope, d_down = est->d_down_root;
+  if (!(s_down > 0)) throw InputError(fmt::format("estimated S^d = {} is not positive", s_down));
+  est->lines = {1.0, d_up, s_down, d_down};
+  // A backlash's ascending border lies right of its descending one; a backlash-inverse's lies left.
+  est->kind = d_up >= d_down ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
+  if (est->kind == OperatorKind::kBacklashInverse && (est->j_a > 0 || est->j_d > 0))
+    est->warnings += fmt::format("line order says backlash-inverse but plateaus were seen (j_a = {}, j_d = {}). ",
+                                 est->j_a, est->j_d);
+  est->params = ParamsFromLines(est->kind, est->lines);
+  summary->ok = true;
+  summary->message = fmt::format("{} detected; p = {}, j_a = {}, j_d = {}; d+ = {:.4f}, S^d = {:.4f}, d- = {:.4f}",
+                                 ToString(est->kind), p, est->j_a, est->j_d, est->params.offset_up,
+                                 est->params.slope_down, est->params.offset_down);
+  if (!est->warnings.empty()) summary->message += "; warnings: " + est->warnings;
+}
+
+namespace {
+nlohmann::json HoldJson(const HoldAverage& h) {
+  return {{"level", h.level}, {"mean", h.mean}, {"std_error", h.std_error}, {"samples", h.samples}};
+}
+HoldAverage HoldFromJson(const nlohmann::json& j) {
+  return {j.at("level").get<double>(), j.at("mean").get<double>(), j.at("std_error").get<double>(),
+          j.at("samples").get<int>()};
+}
+}  // namespace
+
+nlohmann::json NonlinearEstimate::to_json() const {
+  nlohmann::json j;
+  j["operator"] = ToString(kind);
+  j["degree"] = degree;
+  j["j_a"] = j_a;
+  j["j_d"] = j_d;
+  j["params"] = {{"S_a", params.slope_up}, {"d_plus", params.offset_up}, {"S_d", params.slope_down},
+                 {"d_minus", params.offset_down}};
+  j["lines"] = {{"slope_up", lines.slope_up}, {"root_up", lines.root_up}, {"slope_down", lines.slope_down},
+                {"root_down", lines.root_down}};
+  j["descending_readings"] = {
+      {"paper_coefficients", {{"S_d", s_down_leading}, {"d_minus", d_down_coefficient}}},
+      {"leading_and_root", {{"S_d", s_down_leading}, {"d_minus", d_down_root}}},
+      {"root_and_slope", {{"S_d", s_down_slope}, {"d_minus", d_down_root}}}};
+  j["h"] = h;
+  j["q_up"] = q_up;
+  j["q_down"] = q_down;
+  j["reset"] = HoldJson(reset);
+  j["up"] = nlohmann::json::array();
+  for (const auto& h : up) j["up"].push_back(HoldJson(h));
+  j["down"] = nlohmann::json::array();
+  for (const auto& h : down) j["down"].push_back(HoldJson(h));
+  j["warnings"] = warnings;
+  return j;
+}
+
+NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j) {
+  try {
+    NonlinearEstimate e;
+    const auto op = j.at("operator").get<std::string>();
+    if (op != "backlash" && op != "backlash-inverse")
+      throw InputError(fmt::format("operator '{}' must be 'backlash' or 'backlash-inverse'", op));
+    e.kind = op == "backlash" ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
+    e.degree = j.at("degree").get<int>();
+    e.j_a = j.value("j_a", 0);
+    e.j_d = j.value("j_d", 0);
+    const auto& pj = j.at("params");
+    e.params = {pj.at("S_a").get<double>(), pj.at("d_plus").get<double>(), pj.at("S_d").get<double>(),
+                pj.at("d_minus").get<double>()};
+    e.lines = LinesOf(e.kind, e.params);
+    e.h = j.at("h").get<std::vector<double>>();
+    e.q_up = j.value("q_up", std::vector<double>{});
+    e.q_down = j.value("q_down", std::vector<double>{});
+    if (j.contains("reset")) e.reset = HoldFromJson(j.at("reset"));
+    for (const auto& h : j.value("up", nlohmann::json::array())) e.up.push_back(HoldFromJson(h));
+    for (const auto& h : j.value("down", nlohmann::json::array())) e.down.push_back(HoldFromJson(h));
+    e.warnings = j.value("warnings", std::string());
+    std::string err;
+    if (!e.params.IsValid(&err)) throw InputError("nonlinear estimate: " + err);
+    if (e.h.size() < 2 || static_cast<int>(e.h.size()) != e.degree + 1)
+      throw InputError(fmt::format("nonlinear estimate: h has {} coefficients, degree {} needs {}", e.h.size(),
+                                   e.degree, e.degree + 1));
+    return e;
+  } catch (const nlohmann::json::exception& ex) {
+    throw InputError(std::string("nonlinear estimate JSON: ") + ex.what());
+  }
+}
+
+MemoryOperator NonlinearEstimate::Precompensator() const {
+  // Compensator lines are the estimate's lines with u and v swapped (Lemma 1).
+  const OperatorKind other =
+      kind == OperatorKind::kBacklash ? OperatorKind::kBacklashInverse : OperatorKind::kBacklash;
+  const OperatorLines l = LinesOf(kind, params);
+  // Cancelling a line v = s (u - r) needs u = v / s + r = (1/s)(v - (-s r)).
+  const OperatorLines inv{1.0 / l.slope_up, -l.slope_up * l.root_up, 1.0 / l.slope_down, -l.slope_down * l.root_down};
+  return MemoryOperator(other, ParamsFromLines(other, inv));
+}
+
+}  // namespace hw::brouri
