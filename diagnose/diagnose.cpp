@@ -124,10 +124,7 @@ void Diagnose(const DiagnoseOptions& o, const HwModel& nominal, const Recording&
     }
   r.noise_estimated = !(o.noise_std > 0);
   r.noise_std = r.noise_estimated ? EstimateNoiseStd(e_nom, skip) : o.noise_std;
-  r.mask = MismatchMask(e_nom, r.noise_std, skip, o.windows);
-  r.windows = MaskToWindows(r.mask);
   r.conditions = OperatingConditions(ident.u, r.ident_nominal_sim);
-  r.region = CharacteriseRegion(r.conditions, r.mask, e_nom, skip);
   r.whiteness_nominal = WhitenessTest(e_nom, skip, o.max_lag);
   r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, skip, o.max_lag);
 
@@ -141,6 +138,7 @@ void Diagnose(const DiagnoseOptions& o, const HwModel& nominal, const Recording&
   const double mse_base = Mse(e_base, nfit, n);
   const auto candidates = o.candidates.empty() ? CandidateEffects() : o.candidates;
   const double nf = static_cast<double>(nfit - skip);
+  std::vector<Vec> residuals;  // per finding, on the whole identification recording
   for (const auto& [effect, location] : candidates) {
     const RefitResult fit = RefitWithEffect(base.model.nominal, effect, location, fitseg, o.refit);
     if (fit.model.block.effect == Effect::kNone) continue;
@@ -155,6 +153,26 @@ void Diagnose(const DiagnoseOptions& o, const HwModel& nominal, const Recording&
     const double nh = static_cast<double>(n - nfit);
     f.score = 1.0 - f.mse_ratio * std::exp(k * std::log(nh) / nh) * (nf + k) / std::max(nf - k, 1.0);
     f.z = PairedZ(e_base, e1, nfit, n, batch);
+    f.significant = f.z >= o.significance_z && f.score >= o.min_improvement;
+    residuals.push_back(e1);
+    r.findings.push_back(f);
+  }
+  // The noise level is at most the RMS error of the best significant candidate on its fitting part:
+  // the differences-based estimate alone is inflated when the model error is not smooth.
+  double best_fit_rms = HUGE_VAL;
+  for (std::size_t i = 0; i < r.findings.size(); ++i)
+    if (r.findings[i].significant) {
+      double s2 = 0.0;
+      for (std::size_t t = skip; t < nfit; ++t) s2 += residuals[i][t] * residuals[i][t];
+      best_fit_rms = std::min(best_fit_rms, std::sqrt(s2 / std::max<std::size_t>(1, nfit - skip)));
+    }
+  if (r.noise_estimated) r.noise_std = std::min(r.noise_std, best_fit_rms);
+  r.mask = MismatchMask(e_nom, r.noise_std, skip, o.windows);
+  r.windows = MaskToWindows(r.mask);
+  r.region = CharacteriseRegion(r.conditions, r.mask, e_nom, skip);
+  for (std::size_t i = 0; i < r.findings.size(); ++i) {
+    Finding& f = r.findings[i];
+    const Vec& e1 = residuals[i];
     double in = 0.0, all = 0.0;
     for (std::size_t t = nfit; t < n; ++t) {
       const double d = e_base[t] * e_base[t] - e1[t] * e1[t];
@@ -162,13 +180,11 @@ void Diagnose(const DiagnoseOptions& o, const HwModel& nominal, const Recording&
       if (r.mask[t]) in += d;
     }
     f.in_window_share = all > 0 ? in / all : 0.0;
-    f.significant = f.z >= o.significance_z && f.score >= o.min_improvement;
     f.evidence = fmt::format(
         "held-out MSE {:.3g}x the refitted nominal's (penalised reduction {:.1f} %, z = {:.1f}{}); {:.0f} % of the "
         "reduction falls in the mismatch windows; {}",
         f.mse_ratio, 100 * f.score, f.z, f.significant ? ", significant" : ", not significant",
         100 * f.in_window_share, ParamText(f.block));
-    r.findings.push_back(f);
   }
   std::sort(r.findings.begin(), r.findings.end(), [](const Finding& a, const Finding& b) {
     if (a.significant != b.significant) return a.significant;

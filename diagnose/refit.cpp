@@ -193,7 +193,7 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
       LinearBlock num{{}, nominal.linear.b, nominal.linear.delay};
       const double s = std::max(Rms(num.simulate(x)), 1e-12);
       const double zr = std::max(Rms(zhat), 1e-12);
-      for (double c : LogSpace(1e-3, 0.5, 18)) {
+      for (double c : LogSpace(1e-4, 10.0, 36)) {
         const double val = e == Effect::kCubicStiffness ? c * s / (zr * zr * zr) : c * s;
         g.push_back({val});
         g.push_back({-val});

@@ -19,7 +19,7 @@
 namespace hw::diagnose {
 
 struct LmOptions {
-  int max_iterations = 40;
+  int max_iterations = 100;
   double relative_tolerance = 1e-9;
   bool IsValid(std::string* error) const;
 };
@@ -60,7 +60,7 @@ HwModel FitNominal(const NominalSpec& spec, const Segment& data);
 
 struct RefitOptions {
   bool refit_maps = true;   // also re-estimate polynomial map coefficients (first coefficient held at its value)
-  int keep_grid_points = 2; // grid points refined by LM
+  int keep_grid_points = 3; // grid points refined by LM
   LmOptions lm;
   bool IsValid(std::string* error) const;
 };

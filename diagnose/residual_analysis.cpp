@@ -135,6 +135,12 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
   std::size_t nmask = 0;
   for (std::size_t t = skip; t < mask.size(); ++t) nmask += mask[t];
   if (nmask == 0) return best;
+  // When the mask covers most samples it no longer separates anything: rank rules by how much more
+  // of the squared error than of the samples they capture instead.
+  const bool informative = nmask < 0.6 * (mask.size() - skip);
+  double e_total = 0.0;
+  for (std::size_t t = skip; t < e.size(); ++t) e_total += e[t] * e[t];
+  const double nall = static_cast<double>(mask.size() - skip);
   double best_score = -1.0;
   for (const auto& c : conditions) {
     std::vector<double> vals(c.values.begin() + std::min(skip, c.values.size()), c.values.end());
@@ -163,8 +169,10 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
         const double prec = double(tp) / sel, rec = double(tp) / nmask;
         const double f1 = prec + rec > 0 ? 2 * prec * rec / (prec + rec) : 0.0;
         const double lift = (e_in / n_in) / std::max(e_out / n_out, 1e-300);
-        if (f1 > best_score && lift > 1.0) {
-          best_score = f1;
+        const double concentration = e_in / std::max(e_total, 1e-300) - n_in / nall;
+        const double score = informative ? f1 : concentration;
+        if (score > best_score && lift > 1.3 && n_in >= 0.05 * nall) {
+          best_score = score;
           best.found = true;
           best.condition = c.name;
           best.relation = above ? "above" : "below";
@@ -195,9 +203,14 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
         {"abs_dy", "|dy| per sample"}};
     d = fmt::format("{} {} {}", label.count(n) ? label.at(n) : n, above ? "above" : "at or below", th);
   }
-  best.description = fmt::format("{} (covers {:.0f} % of the mismatch samples; {:.0f} % of the samples meeting it "
-                                 "are mismatched; error there {:.1f}x elsewhere)",
-                                 d, 100 * best.recall, 100 * best.precision, best.lift);
+  if (informative)
+    best.description = fmt::format("{} (covers {:.0f} % of the mismatch samples; {:.0f} % of the samples meeting it "
+                                   "are mismatched; mean-square error there {:.1f}x elsewhere)",
+                                   d, 100 * best.recall, 100 * best.precision, best.lift);
+  else
+    best.description = fmt::format("error beyond the noise almost everywhere ({:.0f} % of the samples); it is largest "
+                                   "for {} (mean-square error there {:.1f}x elsewhere)",
+                                   100.0 * nmask / nall, d, best.lift);
   return best;
 }
 
