@@ -11,6 +11,7 @@ void AddPopCommand(CLI::App& app);
 void AddBoundsCommand(CLI::App& app);
 void AddDiagnoseCommand(CLI::App& app);
 void AddScenarioCommand(CLI::App& app);
+void AddBrouriCommand(CLI::App& app);
 // Further commands are declared here as their modules land (bounds, brouri, esmaeilani, diagnose, compare).
 
 }  // namespace hw::cli

@@ -28,7 +28,14 @@ std::vector<HoldAverage> AverageHolds(const std::vector<double>& y, const std::v
     double ss = 0.0;
     for (std::size_t i = begin; i < end; ++i) ss += (y[i] - mean) * (y[i] - mean);
     const double sd = std::sqrt(ss / (average_samples - 1));
-    out.push_back({levels[j], mean, sd / std::sqrt(static_cast<double>(average_samples)), average_samples});
+    HoldAverage h{levels[j], mean, sd / std::sqrt(static_cast<double>(average_samples)), average_samples};
+    const std::size_t first = end - static_cast<std::size_t>(hold_samples);
+    for (std::size_t i = first; i < end; ++i) h.hold_mean += y[i];
+    h.hold_mean /= hold_samples;
+    double hs = 0.0;
+    for (std::size_t i = first; i < end; ++i) hs += (y[i] - h.hold_mean) * (y[i] - h.hold_mean);
+    h.hold_std_error = std::sqrt(hs / (hold_samples - 1) / hold_samples);
+    out.push_back(h);
   }
   return out;
 }
@@ -64,13 +71,21 @@ DownBorderMethod DownBorderMethodFromString(const std::string& name) {
 
 namespace {
 
-// Number of leading holds whose output equals the reference hold's (the plateau, eqs. 7a/14a).
+// Number of leading holds whose output equals the reference hold's (the plateau, eqs. 7a/14a). Each
+// candidate's whole-hold mean is compared with the pooled reference; accepted holds join the pool.
 int PlateauLength(const HoldAverage& ref, const std::vector<HoldAverage>& holds, const NonlinearOptions& o,
                   double scale) {
+  const double floor = 1e-6 * scale + 1e-15;
+  double wsum = 1.0 / std::pow(std::max(ref.std_error, floor), 2), msum = ref.mean * wsum;
   int n = 0;
   for (const auto& h : holds) {
-    const double tol = o.plateau_sigmas * std::hypot(h.std_error, ref.std_error) + o.plateau_abs_tol + 1e-6 * scale;
-    if (std::abs(h.mean - ref.mean) > tol) break;
+    const bool whole = h.hold_std_error > 0;
+    const double mean = whole ? h.hold_mean : h.mean, se = std::max(whole ? h.hold_std_error : h.std_error, floor);
+    const double ref_mean = msum / wsum, ref_se = 1.0 / std::sqrt(wsum);
+    const double tol = o.plateau_sigmas * std::hypot(se, ref_se) + o.plateau_abs_tol + floor;
+    if (std::abs(mean - ref_mean) > tol) break;
+    wsum += 1.0 / (se * se);
+    msum += mean / (se * se);
     ++n;
   }
   return n;
@@ -220,11 +235,12 @@ void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& 
 
 namespace {
 nlohmann::json HoldJson(const HoldAverage& h) {
-  return {{"level", h.level}, {"mean", h.mean}, {"std_error", h.std_error}, {"samples", h.samples}};
+  return {{"level", h.level},         {"mean", h.mean},           {"std_error", h.std_error},
+          {"samples", h.samples},     {"hold_mean", h.hold_mean}, {"hold_std_error", h.hold_std_error}};
 }
 HoldAverage HoldFromJson(const nlohmann::json& j) {
   return {j.at("level").get<double>(), j.at("mean").get<double>(), j.at("std_error").get<double>(),
-          j.at("samples").get<int>()};
+          j.at("samples").get<int>(), j.value("hold_mean", 0.0), j.value("hold_std_error", 0.0)};
 }
 }  // namespace
 
@@ -287,13 +303,14 @@ NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j) {
 }
 
 MemoryOperator NonlinearEstimate::Precompensator() const {
-  // Compensator lines are the estimate's lines with u and v swapped (Lemma 1).
-  const OperatorKind other =
-      kind == OperatorKind::kBacklash ? OperatorKind::kBacklashInverse : OperatorKind::kBacklash;
+  // The input must sit on the "up" line v = s (u - r) while z rises and on the "down" line while it
+  // falls: u = z / s + r, switching lines at each reversal. That is an operator of the eq. 2 (jump) form
+  // for BOTH kinds. For a backlash it is the backlash-inverse of Lemma 1 and the cascade is exact. For a
+  // backlash-inverse plant, the jump at a reversal goes the "wrong" way (u rises while z starts falling),
+  // so the plant follows its up line for that one sample: a glitch that lasts zero time in continuous
+  // time and one sample here. (Lemma 1's second claim, B_inv o B = I, does not hold inside the gap.)
   const OperatorLines l = LinesOf(kind, params);
-  // Cancelling a line v = s (u - r) needs u = v / s + r = (1/s)(v - (-s r)).
-  const OperatorLines inv{1.0 / l.slope_up, -l.slope_up * l.root_up, 1.0 / l.slope_down, -l.slope_down * l.root_down};
-  return MemoryOperator(other, ParamsFromLines(other, inv));
+  return MemoryOperator(OperatorKind::kBacklashInverse, {l.slope_up, l.root_up, l.slope_down, l.root_down});
 }
 
 }  // namespace hw::brouri

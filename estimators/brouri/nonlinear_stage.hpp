@@ -8,7 +8,9 @@
 //   ascending level is reached by an increase; the paper's plateau (eq. 7a, V_j = F[U_1]) is then
 //   "same output as the reset hold", and for the descending stage "same output as the last ascending hold".
 // In steady state the system is the static map h o F (eq. 5); eq. 9 averages the last M samples of each
-// hold. j_a, j_d (length of the plateaus) are detected from the data with a significance test.
+// hold. j_a, j_d (length of the plateaus) are detected from the data with a significance test: a hold is
+// on the plateau while the mean of its whole hold equals the pooled reference (reset hold's tail and the
+// plateau holds found so far) within plateau_sigmas standard errors.
 // With the normalised model (eq. 4: S^a = 1, G(0) = 1):
 //   ascending border points:  X_j = h(U_j - d+)            -> degree-p fit q_a, d+ = its root (h(0) = 0)
 //   h(u) = q_a(u + d+)                                      (eq. 12)
@@ -39,6 +41,9 @@ struct HoldAverage {
   double mean = 0.0;    // X^_j(M)
   double std_error = 0.0;
   int samples = 0;
+  // Over the WHOLE hold: on a plateau v does not move, so y is flat from the hold's first sample and
+  // all of it can be compared with the reference; this gives the plateau test far more samples than M.
+  double hold_mean = 0.0, hold_std_error = 0.0;
 };
 // Holds are consecutive blocks of `hold_samples` samples of y starting at sample 0.
 std::vector<HoldAverage> AverageHolds(const std::vector<double>& y, const std::vector<double>& levels,
@@ -73,8 +78,8 @@ struct NonlinearEstimate {
 
   nlohmann::json to_json() const;
   static NonlinearEstimate from_json(const nlohmann::json& j);  // throws InputError
-  // The pre-compensator of Fig. 8 that cancels the estimated operator: a backlash-inverse for a
-  // backlash and a backlash for a backlash-inverse (Lemma 1).
+  // The pre-compensator of Fig. 8 that cancels the estimated operator (see the .cpp for the
+  // backlash-inverse plant, where the paper's Lemma 1 overstates what a backlash can do).
   MemoryOperator Precompensator() const;
 };
 

@@ -215,6 +215,33 @@ BacklashHwSystem BacklashHwSystem::Normalised() const {
   return out;
 }
 
+nlohmann::json BacklashHwSystem::to_json() const {
+  return {{"operator", ToString(kind)}, {"S_a", backlash.slope_up}, {"d_plus", backlash.offset_up},
+          {"S_d", backlash.slope_down}, {"d_minus", backlash.offset_down}, {"num", g.num}, {"den", g.den},
+          {"h", h}, {"noise_std", noise_std}};
+}
+
+BacklashHwSystem BacklashHwSystem::from_json(const nlohmann::json& j) {
+  BacklashHwSystem s;
+  try {
+    const auto op = j.value("operator", std::string("backlash"));
+    if (op != "backlash" && op != "backlash-inverse")
+      throw InputError(fmt::format("system JSON: operator '{}' must be 'backlash' or 'backlash-inverse'", op));
+    s.kind = op == "backlash" ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
+    s.backlash = {j.at("S_a").get<double>(), j.at("d_plus").get<double>(), j.at("S_d").get<double>(),
+                  j.at("d_minus").get<double>()};
+    s.g.num = j.at("num").get<std::vector<double>>();
+    s.g.den = j.at("den").get<std::vector<double>>();
+    s.h = j.at("h").get<std::vector<double>>();
+    s.noise_std = j.value("noise_std", 0.0);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("system JSON: ") + e.what());
+  }
+  std::string err;
+  if (!s.IsValid(&err)) throw InputError("system JSON: " + err);
+  return s;
+}
+
 SimulationResult Simulate(const BacklashHwSystem& system, const std::vector<double>& u, double sample_time,
                           std::uint64_t seed, const MemoryOperator* precompensator) {
   std::string err;

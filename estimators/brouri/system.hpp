@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <nlohmann/json.hpp>
 
 namespace hw::brouri {
 
@@ -97,6 +98,10 @@ struct BacklashHwSystem {
   // The normalised model of eq. 4: operator divided by its "up" slope, G(0) = 1, h absorbing both.
   // Its input-output behaviour is identical to the original's.
   BacklashHwSystem Normalised() const;
+  // {"operator": "backlash"|"backlash-inverse", "S_a", "d_plus", "S_d", "d_minus",
+  //  "num": [...], "den": [...] (descending powers of s), "h": [h0, h1, ...], "noise_std"}
+  nlohmann::json to_json() const;
+  static BacklashHwSystem from_json(const nlohmann::json& j);  // throws InputError
 };
 
 // Simulates the sampled system on input u (one value per sample, held between samples).
