@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   hw::cli::AddBoundsCommand(app);
   hw::cli::AddDiagnoseCommand(app);
   hw::cli::AddScenarioCommand(app);
+  hw::cli::AddBrouriCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
