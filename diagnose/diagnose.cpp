@@ -72,6 +72,7 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!(significance_z > 0) || !(validation_z >= 0)) return fail("significance_z > 0 and validation_z >= 0 required");
   if (!(min_improvement >= 0 && min_improvement < 1)) return fail("min_improvement must be in [0, 1)");
   if (max_lag < 1) return fail("max_lag must be >= 1");
+  if (max_validated < 1) return fail("max_validated must be >= 1");
   return windows.IsValid(error) && refit.IsValid(error);
 }
 
@@ -206,32 +207,40 @@ void Diagnose(const DiagnoseOptions& o, const HwModel& nominal, const Recording&
   r.valid_augmented_sim = v_base;
   r.augmented = refit_better ? r.nominal_refit : r.nominal;
   r.ident_augmented_sim = refit_better ? nom_full.model.simulate(ident.u) : r.ident_nominal_sim;
-  if (!r.findings.empty() && r.findings.front().significant) {
-    const Finding& best = r.findings.front();
+  // Significant candidates are confirmed on validation in rank order (at most max_validated): near-tied
+  // blocks (e.g. saturation at input, output or in the state) can differ in how they extrapolate.
+  std::string rejected;
+  int tried = 0;
+  for (const Finding& best : r.findings) {
+    if (!best.significant || tried >= o.max_validated) break;
+    ++tried;
     RefitResult aug = RefitWithEffect(nom_full.model.nominal, best.block.effect, best.block.location, full, o.refit);
     const Vec v_aug = aug.model.simulate(valid.u);
     const FitFigures fa = Figures(valid.y, v_aug, skip);
     const Vec e0 = Residual(valid.y, v_base), e1 = Residual(valid.y, v_aug);
-    r.validation_z = PairedZ(e0, e1, skip, valid.y.size(), batch);
+    const double z = PairedZ(e0, e1, skip, valid.y.size(), batch);
     const auto b = aug.model.block;
-    if (b.effect != Effect::kNone && r.validation_z >= o.validation_z &&
+    if (b.effect != Effect::kNone && z >= o.validation_z &&
         fa.rmse * fa.rmse <= (1.0 - o.min_improvement) * r.augmented.rmse * r.augmented.rmse) {
+      r.validation_z = z;
       r.verdict = b.effect;
       r.verdict_location = b.location;
       r.augmented_model = aug.model;
       r.augmented = fa;
       r.valid_augmented_sim = v_aug;
       r.ident_augmented_sim = aug.model.simulate(ident.u);
-      r.validation_note = fmt::format("validation confirms: paired z = {:.1f} >= {:.1f}", r.validation_z, o.validation_z);
-    } else {
-      r.validation_note = fmt::format(
-          "{}@{} improved the held-out identification tail but not the validation recording (paired z = {:.1f}, needed {:.1f}, "
-          "and an MSE reduction of at least {:.0f} %): verdict none",
-          EffectName(best.block.effect), LocationName(best.block.location), r.validation_z, o.validation_z, 100 * o.min_improvement);
+      r.validation_note = fmt::format("{}validation confirms {}@{}: paired z = {:.1f} >= {:.1f}", rejected,
+                                      EffectName(b.effect), LocationName(b.location), z, o.validation_z);
+      break;
     }
-  } else {
-    r.validation_note = "no candidate improved the held-out identification tail significantly";
+    rejected += fmt::format("{}@{} improved the held-out identification tail but not the validation recording (paired "
+                            "z = {:.1f}, needed {:.1f} and an MSE reduction of at least {:.0f} %); ",
+                            EffectName(best.block.effect), LocationName(best.block.location), z, o.validation_z,
+                            100 * o.min_improvement);
   }
+  if (r.verdict == Effect::kNone)
+    r.validation_note = tried == 0 ? "no candidate improved the held-out identification tail significantly"
+                                   : rejected + "verdict none";
   r.ident_nominal = Figures(ident.y, r.ident_nominal_sim, skip);
   r.ident_augmented = Figures(ident.y, r.ident_augmented_sim, skip);
   const Vec e_aug_valid = Residual(valid.y, r.valid_augmented_sim);

@@ -17,7 +17,8 @@
 //     significant when z >= significance_z and the penalised MSE reduction >= min_improvement.
 //  3. Model and refit — the best significant candidate is refitted on the whole identification
 //     recording and must also beat the nominal model on the validation recording (paired z >=
-//     validation_z); otherwise the verdict is "none".
+//     validation_z and an MSE reduction >= min_improvement); if it does not, the next significant
+//     candidates are tried in rank order (at most max_validated); otherwise the verdict is "none".
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,7 @@ struct DiagnoseOptions {
   double significance_z = 1.5;        // held-out paired test threshold (a pre-screen; validation decides)
   double min_improvement = 0.05;      // minimum penalised held-out MSE reduction (fraction)
   double validation_z = 2.0;          // the verdict must also beat the nominal on validation
+  int max_validated = 3;              // significant candidates tried on validation, in rank order
   int max_lag = 25;                   // lags of the correlation tests
   WindowOptions windows;
   RefitOptions refit;

@@ -22,24 +22,28 @@ double Quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (v.size() - 1))];
 }
 
-std::vector<double> SinceReversal(const std::vector<double>& s) {
+// Reversals with a dead band of 3 % of the signal's range, so that dither or noise does not count:
+// a reversal is a move of more than the band back from the extreme reached since the last one.
+// Fills the samples since the last reversal and the current direction (+1 rising, -1 falling).
+void Reversals(const std::vector<double>& s, std::vector<double>* since, std::vector<double>* direction) {
   const std::size_t n = s.size();
-  std::vector<double> out(n, 0.0);
-  double scale = 0.0;
-  for (std::size_t t = 1; t < n; ++t) scale = std::max(scale, std::abs(s[t] - s[t - 1]));
-  const double tiny = 1e-9 * scale;
+  since->assign(n, static_cast<double>(n));
+  direction->assign(n, 0.0);
+  if (n == 0) return;
+  const auto [lo, hi] = std::minmax_element(s.begin(), s.end());
+  const double band = 0.03 * (*hi - *lo);
   int dir = 0;
-  long last = -static_cast<long>(n);
+  double ext = s[0];
+  long last = -1;  // before the first reversal: samples since the start
   for (std::size_t t = 0; t < n; ++t) {
-    if (t > 0) {
-      const double d = s[t] - s[t - 1];
-      const int nd = d > tiny ? 1 : (d < -tiny ? -1 : 0);
-      if (nd != 0 && dir != 0 && nd != dir) last = static_cast<long>(t);
-      if (nd != 0) dir = nd;
-    }
-    out[t] = static_cast<double>(std::min<long>(static_cast<long>(t) - last, static_cast<long>(n)));
+    if (dir >= 0 && s[t] > ext) ext = s[t];
+    if (dir <= 0 && s[t] < ext) ext = s[t];
+    if (dir == 0 && std::abs(s[t] - s[0]) > band) dir = s[t] > s[0] ? 1 : -1, ext = s[t];
+    if (dir > 0 && s[t] < ext - band) dir = -1, ext = s[t], last = static_cast<long>(t);
+    if (dir < 0 && s[t] > ext + band) dir = 1, ext = s[t], last = static_cast<long>(t);
+    (*since)[t] = static_cast<double>(std::min<long>(static_cast<long>(t) - last, static_cast<long>(n)));
+    (*direction)[t] = dir;
   }
-  return out;
 }
 
 std::string Num(double v) { return fmt::format("{:.4g}", v); }
@@ -116,17 +120,69 @@ std::vector<Condition> OperatingConditions(const std::vector<double>& u, const s
   c.push_back({"abs_du", "input rate magnitude |du|", absv(du)});
   c.push_back({"dy", "output rate dy (model)", dy});
   c.push_back({"abs_dy", "output rate magnitude |dy| (model)", absv(dy)});
-  c.push_back({"since_rev_u", "samples since the last reversal of u", SinceReversal(u)});
-  c.push_back({"since_rev_y", "samples since the last reversal of y (model)", SinceReversal(y)});
+  std::vector<double> since_u, dir_u, since_y, dir_y;
+  Reversals(u, &since_u, &dir_u);
+  Reversals(y, &since_y, &dir_y);
+  c.push_back({"since_rev_u", "samples since the last reversal of u", since_u});
+  c.push_back({"since_rev_y", "samples since the last reversal of y (model)", since_y});
+  c.push_back({"dir_u", "direction of u since its last reversal (+1 rising, -1 falling)", dir_u});
+  c.push_back({"dir_y", "direction of y since its last reversal (model)", dir_y});
   return c;
 }
 
 nlohmann::json Region::to_json() const {
-  if (!found) return {{"description", description}, {"condition", nullptr}};
+  nlohmann::json b = nullptr;
+  if (bias.found)
+    b = {{"description", bias.description}, {"condition", bias.condition},   {"threshold", bias.threshold},
+         {"mean_error_above", bias.mean_above}, {"mean_error_below", bias.mean_below}, {"effect_size", bias.effect_size}};
+  if (!found) return {{"description", description}, {"condition", nullptr}, {"signed_error", b}};
   return {{"description", description}, {"condition", condition}, {"relation", relation},
           {"threshold", threshold},     {"precision", precision}, {"recall", recall},
-          {"error_lift", lift}};
+          {"error_lift", lift},         {"signed_error", b}};
 }
+
+namespace {
+void FindBias(const std::vector<Condition>& conditions, const std::vector<double>& e, std::size_t skip, Region* r) {
+  double mean = 0.0, var = 0.0;
+  const double nall = static_cast<double>(e.size() - skip);
+  for (std::size_t t = skip; t < e.size(); ++t) mean += e[t];
+  mean /= nall;
+  for (std::size_t t = skip; t < e.size(); ++t) var += (e[t] - mean) * (e[t] - mean);
+  const double sd = std::sqrt(var / nall);
+  if (!(sd > 0)) return;
+  for (const auto& c : conditions) {
+    if (c.name.rfind("abs_", 0) == 0) continue;
+    std::vector<double> vals(c.values.begin() + skip, c.values.end());
+    std::vector<double> ths;
+    for (int i = 1; i < 20; ++i) ths.push_back(Quantile(vals, i / 20.0));
+    if (c.name == "dir_u" || c.name == "dir_y") ths = {0.0};
+    std::sort(ths.begin(), ths.end());
+    ths.erase(std::unique(ths.begin(), ths.end()), ths.end());
+    for (double th : ths) {
+      double s_in = 0.0, s_out = 0.0;
+      std::size_t n_in = 0, n_out = 0;
+      for (std::size_t t = skip; t < e.size(); ++t)
+        (c.values[t] > th ? (s_in += e[t], ++n_in) : (s_out += e[t], ++n_out));
+      if (n_in < 0.1 * nall || n_out < 0.1 * nall) continue;
+      const double ma = s_in / n_in, mb = s_out / n_out, es = std::abs(ma - mb) / sd;
+      if (es > r->bias.effect_size) r->bias = {true, c.name, "", th, ma, mb, es};
+    }
+  }
+  if (!r->bias.found || r->bias.effect_size < 0.5) {
+    r->bias = {};
+    return;
+  }
+  const auto& b = r->bias;
+  const bool dir = b.condition == "dir_u" || b.condition == "dir_y";
+  const std::string sig = b.condition.find('u') != std::string::npos ? "u" : "y";
+  b.condition == "dir_u" || b.condition == "dir_y"
+      ? r->bias.description = fmt::format("the error's sign follows the direction of {}: mean {:+.4g} after {} rose, {:+.4g} after it fell "
+                                          "({:.2f} error standard deviations apart)", sig, b.mean_above, sig, b.mean_below, b.effect_size)
+      : r->bias.description = fmt::format("the mean error changes across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} error "
+                                          "standard deviations apart)", b.condition, b.threshold, b.mean_above, b.mean_below, b.effect_size);
+  (void)dir;
+}
+}  // namespace
 
 Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::vector<bool>& mask,
                           const std::vector<double>& e, std::size_t skip) {
@@ -135,6 +191,7 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
   std::size_t nmask = 0;
   for (std::size_t t = skip; t < mask.size(); ++t) nmask += mask[t];
   if (nmask == 0) return best;
+  FindBias(conditions, e, skip, &best);
   // When the mask covers most samples it no longer separates anything: rank rules by how much more
   // of the squared error than of the samples they capture instead.
   const bool informative = nmask < 0.6 * (mask.size() - skip);
@@ -186,6 +243,7 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
   }
   if (!best.found) {
     best.description = "no single operating condition characterises the mismatch windows";
+    if (best.bias.found) best.description += "; " + best.bias.description;
     return best;
   }
   const bool above = best.relation == "above";
@@ -199,7 +257,7 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
   } else {
     static const std::map<std::string, std::string> label = {
         {"u", "u"},     {"abs_u", "|u|"}, {"y", "y"},         {"abs_y", "|y|"},
-        {"du", "du/dt (per sample)"}, {"abs_du", "|du| per sample"}, {"dy", "dy (per sample)"},
+        {"du", "du/dt (per sample)"}, {"dir_u", "direction of u"}, {"dir_y", "direction of y"}, {"abs_du", "|du| per sample"}, {"dy", "dy (per sample)"},
         {"abs_dy", "|dy| per sample"}};
     d = fmt::format("{} {} {}", label.count(n) ? label.at(n) : n, above ? "above" : "at or below", th);
   }
@@ -211,6 +269,7 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
     best.description = fmt::format("error beyond the noise almost everywhere ({:.0f} % of the samples); it is largest "
                                    "for {} (mean-square error there {:.1f}x elsewhere)",
                                    100.0 * nmask / nall, d, best.lift);
+  if (best.bias.found) best.description += "; " + best.bias.description;
   return best;
 }
 

@@ -28,7 +28,8 @@ std::vector<std::pair<std::size_t, std::size_t>> MaskToWindows(const std::vector
 
 // Operating conditions evaluated per sample, e.g. "u", "|du|", "time since reversal of u".
 struct Condition {
-  std::string name;        // machine name: u, y, abs_u, abs_y, du, abs_du, dy, abs_dy, since_rev_u, since_rev_y
+  std::string name;        // machine name: u, y, abs_u, abs_y, du, abs_du, dy, abs_dy, since_rev_u, since_rev_y,
+                           // dir_u, dir_y (sign of the last non-zero change)
   std::string words;       // how a person reads it
   std::vector<double> values;
 };
@@ -43,6 +44,13 @@ struct Region {
   double recall = 0.0;       // fraction of mismatch samples meeting the rule
   double lift = 0.0;         // mean squared error where the rule holds / where it does not
   std::string description;   // e.g. "within 6 samples after a reversal of u"
+  // Signed evidence: the split of one condition across which the mean error changes most (in units of
+  // the error's standard deviation), e.g. a backlash offset that follows the direction of u.
+  struct Bias {
+    bool found = false;
+    std::string condition, description;
+    double threshold = 0.0, mean_above = 0.0, mean_below = 0.0, effect_size = 0.0;
+  } bias;
   nlohmann::json to_json() const;
 };
 // The single threshold rule on one condition that best matches the mismatch mask (F1), weighted by
