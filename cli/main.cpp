@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   hw::cli::AddSimulateCommand(app);
   hw::cli::AddBoundsCommand(app);
+  hw::cli::AddPopCommand(app);
   hw::cli::AddDiagnoseCommand(app);
   hw::cli::AddScenarioCommand(app);
   hw::cli::AddBrouriCommand(app);

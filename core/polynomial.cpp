@@ -291,6 +291,19 @@ class Parser {
       if (peek('*')) {
         ++pos_;
         p = p * unary();
+      } else if (peek('/')) {
+        ++pos_;
+        const std::size_t at = pos_;
+        const Polynomial d = unary();
+        if (d.degree() > 0) {
+          pos_ = at;
+          fail("division is only by a constant");
+        }
+        if (d.constant_term() == 0.0) {
+          pos_ = at;
+          fail("division by zero");
+        }
+        p *= 1.0 / d.constant_term();
       } else if (starts_atom()) {  // juxtaposition: "3 x1"
         p = p * unary();
       } else {

@@ -181,6 +181,11 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                             const std::function<void(const BoundsProgress&)>& progress) {
   std::string error;
   if (!options.IsValid(&error)) throw InputError("bounds options: " + error);
+  // In scaled coordinates every feasible moment vector has |y_alpha| <= 1 (the box localizers bound the even
+  // moments by 1 and the moment matrix bounds the rest; the LP screen states |y| <= 1 explicitly), so a
+  // multiplier X >= 0 with sum_i |F_i . X| < F_0 . X already proves emptiness; 0.5 leaves a margin.
+  BoundsOptions opts = options;
+  opts.generation.sdp.infeasibility_tolerance = std::max(opts.generation.sdp.infeasibility_tolerance, 0.5);
   const auto t0 = Clock::now();
   const int n = set.num_vars();
   const int L = set.num_orthants();
@@ -255,7 +260,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
           std::vector<Polynomial> cons = set.sign_constraints(l);
           for (const auto& g : candidates_of(l)) cons.push_back(g);
           auto solver = sdp::MakeSolver(options.solver);
-          sdp::SdpOptions lp_options = options.generation.sdp;
+          sdp::SdpOptions lp_options = opts.generation.sdp;
           lp_options.keep_dual_matrix = false;
           const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver);
           empty[l] = s.status == sdp::SdpStatus::kInfeasible;
@@ -309,7 +314,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
       std::lock_guard<std::mutex> lock(mu);
       initial.assign(working[l].begin(), working[l].end());
     }
-    ConstraintGenerationOptions gen = options.generation;
+    ConstraintGenerationOptions gen = opts.generation;
     gen.order = d;
     auto solver = sdp::MakeSolver(options.solver);
     const auto r = SolveWithConstraintGeneration(gen, core, candidates_of(l), initial, *solver,

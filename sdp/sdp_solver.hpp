@@ -2,6 +2,7 @@
 // One small interface for interchangeable SDP backends (CSDP, SDPA), in the manner of Ceres:
 // options are a plain struct with defaults and IsValid(), the outcome is a summary with an explicit
 // status and message, and each backend's own details travel beside the common result.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,8 +18,16 @@ struct SdpOptions {
   double gap_tolerance = 1e-7;         // relative duality gap to call a solve optimal
   double feasibility_tolerance = 1e-7;  // relative primal/dual infeasibility
   int max_iterations = 200;
+  // A solve that stops short of gap_tolerance (SDPA "pdFEAS", CSDP "partial success") is still called
+  // optimal when both sides are feasible within this and the relative gap is below it: the reported
+  // bound comes from the feasible dual side, so the gap only costs tightness, not validity.
+  double acceptable_gap = 1e-6;
   bool verbose = false;                 // let the backend print its iteration log
   bool keep_dual_matrix = true;         // return X (needed for verification and for flatness)
+  // An infeasibility claim is accepted only with a certificate: X >= 0 with
+  // sum_i |F_i . X| <= infeasibility_tolerance * F_0 . X (then sum y_i F_i - F_0 >= 0 is impossible for
+  // |y_i| <= 1 / infeasibility_tolerance). Backends' own phase labels are not trusted alone.
+  double infeasibility_tolerance = 1e-4;
   bool IsValid(std::string* error) const;
 };
 
@@ -61,6 +70,26 @@ class SdpSolver {
   virtual std::string name() const = 0;
   virtual SdpSummary Solve(const SdpOptions& options, const LmiProblem& problem) = 0;
 };
+
+// sum_i |F_i . X| / F_0 . X for a candidate certificate X (infinity when X is not PSD or F_0 . X <= 0).
+double InfeasibilityResidual(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X);
+// Turns a backend's infeasibility claim into kInfeasible (certificate checked) or kNumericalTrouble.
+void ConfirmInfeasibility(const SdpOptions& options, const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X,
+                          SdpSummary* summary);
+
+// Promotes kInaccurate to kOptimal when the gap and infeasibilities are within options.acceptable_gap.
+void AcceptNearOptimal(const SdpOptions& options, SdpSummary* summary);
+
+// Backend plumbing shared by CSDP and SDPA. Both choke on a variable whose F_i is zero (CSDP even calls
+// exit()), and duplicate entries mean different things to different solvers, so every backend solves the
+// canonical reduced problem: duplicates summed, zeros dropped, variables with F_i = 0 removed.
+// SolveCanonical() does that, solves with `solve`, and maps y back (removed variables get y_i = 0; a
+// removed variable with c_i != 0 makes a feasible problem unbounded). A problem left without variables is
+// decided directly: F(y) = -F_0 >= 0 or not (an eigenvector of -F_0 certifies infeasibility).
+SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
+                          const std::function<SdpSummary(const LmiProblem&)>& solve);
+// Relative duality gap as both backends report it: |p - d| / max(1, (|p| + |d|) / 2).
+double RelativeGap(double primal, double dual);
 
 // "csdp" or "sdpa"; throws std::invalid_argument for other names.
 std::unique_ptr<SdpSolver> MakeSolver(const std::string& name);

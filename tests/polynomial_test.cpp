@@ -34,6 +34,9 @@ TEST(Polynomial, ParserReportsPositionAndReason) {
   EXPECT_THROW(parse_polynomial("x1^", names), PolynomialParseError);
   EXPECT_THROW(parse_polynomial("(x1 + x2", names), PolynomialParseError);
   EXPECT_THROW(parse_polynomial("", names), PolynomialParseError);
+  EXPECT_THROW(parse_polynomial("x1 / x2", names), PolynomialParseError);
+  EXPECT_THROW(parse_polynomial("x1 / 0", names), PolynomialParseError);
+  EXPECT_DOUBLE_EQ(parse_polynomial("x1^6/3", names).evaluate({2, 0}), 64.0 / 3);
 }
 
 TEST(MonomialBasis, CountsAndIndex) {

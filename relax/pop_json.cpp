@@ -1,0 +1,87 @@
+#include "relax/pop_json.hpp"
+
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+
+namespace hw::relax {
+namespace {
+
+Polynomial parse_field(const std::string& text, const std::vector<std::string>& names, const std::string& where) {
+  try {
+    return parse_polynomial(text, names);
+  } catch (const PolynomialParseError& e) {
+    throw InputError(fmt::format("{}: \"{}\" {}", where, text, e.what()));
+  }
+}
+
+}  // namespace
+
+PolyProblem ParsePolyProblem(const nlohmann::json& j, const std::string& source) {
+  PolyProblem p;
+  if (!j.is_object()) throw InputError(fmt::format("{}: expected a JSON object with variables, minimize/maximize, constraints", source));
+  if (!j.contains("variables") || !j["variables"].is_array() || j["variables"].empty())
+    throw InputError(fmt::format("{}: \"variables\" must be a non-empty list of names, e.g. [\"x1\", \"x2\"]", source));
+  for (const auto& v : j["variables"]) {
+    if (!v.is_string()) throw InputError(fmt::format("{}: every entry of \"variables\" must be a string", source));
+    p.names.push_back(v.get<std::string>());
+  }
+  p.num_vars = static_cast<int>(p.names.size());
+  const bool has_min = j.contains("minimize"), has_max = j.contains("maximize");
+  if (has_min == has_max)
+    throw InputError(fmt::format("{}: give exactly one of \"minimize\" or \"maximize\" (an expression string)", source));
+  const std::string key = has_min ? "minimize" : "maximize";
+  if (!j[key].is_string()) throw InputError(fmt::format("{}: \"{}\" must be an expression string", source, key));
+  p.objective = parse_field(j[key].get<std::string>(), p.names, fmt::format("{}: {}", source, key));
+  p.maximize = has_max;
+  if (j.contains("constraints")) {
+    if (!j["constraints"].is_array()) throw InputError(fmt::format("{}: \"constraints\" must be a list of strings", source));
+    int i = 0;
+    for (const auto& c : j["constraints"]) {
+      const std::string where = fmt::format("{}: constraints[{}]", source, i++);
+      if (!c.is_string()) throw InputError(where + ": expected a string such as \"x1^2 + x2^2 <= 1\"");
+      const std::string text = c.get<std::string>();
+      std::size_t at;
+      if ((at = text.find(">=")) != std::string::npos) {
+        p.inequalities.push_back(parse_field(text.substr(0, at), p.names, where) -
+                                 parse_field(text.substr(at + 2), p.names, where));
+      } else if ((at = text.find("<=")) != std::string::npos) {
+        p.inequalities.push_back(parse_field(text.substr(at + 2), p.names, where) -
+                                 parse_field(text.substr(0, at), p.names, where));
+      } else if ((at = text.find("==")) != std::string::npos) {
+        p.equalities.push_back(parse_field(text.substr(0, at), p.names, where) -
+                               parse_field(text.substr(at + 2), p.names, where));
+      } else {
+        throw InputError(where + ": \"" + text + "\" has no relation; use >=, <= or ==");
+      }
+    }
+  }
+  if (j.contains("box")) {
+    const auto& b = j["box"];
+    if (!b.is_object()) throw InputError(fmt::format("{}: \"box\" must map every variable to [lo, hi]", source));
+    for (const auto& name : p.names) {
+      if (!b.contains(name) || !b[name].is_array() || b[name].size() != 2)
+        throw InputError(fmt::format("{}: box: variable '{}' needs [lo, hi]", source, name));
+      p.box.push_back({b[name][0].get<double>(), b[name][1].get<double>()});
+    }
+  }
+  std::string error;
+  if (!p.IsValid(&error)) throw InputError(fmt::format("{}: {}", source, error));
+  return p;
+}
+
+PolyProblem LoadPolyProblem(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open problem file", path));
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+  return ParsePolyProblem(j, path);
+}
+
+}  // namespace hw::relax

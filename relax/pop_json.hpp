@@ -1,0 +1,21 @@
+#pragma once
+// Polynomial optimisation problems from JSON, for `hwbounds pop`:
+// {
+//   "variables": ["x1", "x2"],
+//   "minimize": "x1^2 + x2",              (or "maximize")
+//   "constraints": ["x1^2 + x2^2 <= 1", "x1 - x2 == 0", "x2 >= -1"],
+//   "box": {"x1": [-2, 2], "x2": [-2, 2]}   (optional; all variables or none)
+// }
+// Errors name the file, the field and, inside an expression, the character position.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "relax/moment_relaxation.hpp"
+
+namespace hw::relax {
+
+PolyProblem ParsePolyProblem(const nlohmann::json& j, const std::string& source);
+PolyProblem LoadPolyProblem(const std::string& path);
+
+}  // namespace hw::relax

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages hwbounds needs and builds it (Release) into build/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PACKAGES=(cmake g++ make libeigen3-dev libsdp-dev coinor-csdp libsdpa-dev sdpa libsuitesparse-dev libcli11-dev
+          nlohmann-json3-dev libfmt-dev gnuplot-nox libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
+          coinor-libipopt-dev libcgal-dev libgmp-dev libmpfr-dev libtbb-dev pkg-config)
+missing=()
+for p in "${PACKAGES[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"
+fi
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"

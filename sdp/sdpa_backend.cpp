@@ -1,0 +1,161 @@
+#include "sdp/sdpa_backend.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <sdpa_call.h>
+
+extern "C" void openblas_set_num_threads(int);
+
+namespace hw::sdp {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Thread safety: SDPA 7.3.16 is NOT safe to run concurrently. Its Schur-complement assembly hands
+// columns to worker threads through static class members (sdpa::Newton::Column_Number, job_mutex,
+// job_cond, mutex_flag, Calc_F1: `nm libsdpa.a` shows them in .bss), shared by every SDPA object, and
+// the timing code keeps function-local statics. All SDPA solves in the process are therefore
+// serialised by this mutex; run concurrent jobs with CSDP when throughput matters.
+std::mutex& SdpaMutex() {
+  static std::mutex mu;
+  return mu;
+}
+
+// Jobs run in parallel in our own pool: BLAS (OpenBLAS, shared with CSDP's -lblas alternative) gets
+// one thread, so two solves never oversubscribe the cores. Set once, process-wide.
+void SingleThreadedBlas() {
+  static std::once_flag once;
+  std::call_once(once, [] { openblas_set_num_threads(1); });
+}
+
+// Expects the canonical problem of SolveCanonical(): no duplicates, no zeros, every F_i non-empty.
+SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
+  SdpSummary out;
+  SingleThreadedBlas();
+  std::lock_guard<std::mutex> lock(SdpaMutex());
+  const auto t0 = Clock::now();
+  const int m = problem.num_vars();
+  const int nblocks = static_cast<int>(problem.blocks.size());
+  SDPA sdpa;
+  // SDPA's default parameter set, with our tolerances and iteration limit on top.
+  sdpa.setParameterType(SDPA::PARAMETER_STABLE_BUT_SLOW);
+  sdpa.setParameterMaxIteration(options.max_iterations);
+  sdpa.setParameterEpsilonStar(options.gap_tolerance);
+  sdpa.setParameterEpsilonDash(options.feasibility_tolerance);
+  sdpa.setDisplay(options.verbose ? stdout : nullptr);
+  sdpa.setResultFile(nullptr);
+  sdpa.setNumThreads(1);
+  sdpa.inputConstraintNumber(m);
+  sdpa.inputBlockNumber(nblocks);
+  for (int b = 0; b < nblocks; ++b) {
+    const bool lp = problem.blocks[b].kind == BlockSpec::Kind::kDiagonal;
+    sdpa.inputBlockSize(b + 1, lp ? -problem.blocks[b].size : problem.blocks[b].size);
+    sdpa.inputBlockType(b + 1, lp ? SDPA::LP : SDPA::SDP);
+  }
+  sdpa.initializeUpperTriangleSpace();
+  for (int i = 0; i < m; ++i) sdpa.inputCVec(i + 1, problem.c[i]);
+  for (int i = 0; i <= m; ++i)
+    for (const auto& e : problem.F[i]) sdpa.inputElement(i, e.block + 1, e.row + 1, e.col + 1, e.value);
+  sdpa.initializeUpperTriangle();
+  sdpa.initializeSolve();
+  out.setup_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  const auto t1 = Clock::now();
+  sdpa.solve();
+  out.solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+
+  // SDPA's primal: min c'x, X = sum F_i x_i - F_0 >= 0 (ours, x = y); its dual: max F_0 . Y,
+  // F_i . Y = c_i, Y >= 0 (Y = our multiplier X).
+  out.iterations = sdpa.getIteration();
+  out.primal_value = sdpa.getPrimalObj() + problem.objective_offset;
+  out.lower_bound = sdpa.getDualObj() + problem.objective_offset;
+  out.primal_infeasibility = sdpa.getDualError();  // of F_i . Y = c_i
+  out.dual_infeasibility = sdpa.getPrimalError();  // of the LMI at x
+  out.relative_gap = RelativeGap(sdpa.getPrimalObj(), sdpa.getDualObj());
+  const double* x = sdpa.getResultXVec();
+  out.y.assign(x, x + m);
+  for (int b = 0; b < nblocks; ++b) {
+    const int n = problem.blocks[b].size;
+    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(n, n), S = Eigen::MatrixXd::Zero(n, n);
+    const double* yb = sdpa.getResultYMat(b + 1);
+    const double* sb = sdpa.getResultXMat(b + 1);
+    if (problem.blocks[b].kind == BlockSpec::Kind::kDiagonal) {  // LP blocks come back as vectors
+      for (int i = 0; i < n; ++i) {
+        Y(i, i) = yb[i];
+        S(i, i) = sb[i];
+      }
+    } else {
+      Y = Eigen::Map<const Eigen::MatrixXd>(yb, n, n);
+      S = Eigen::Map<const Eigen::MatrixXd>(sb, n, n);
+    }
+    out.X.push_back(std::move(Y));
+    out.Z.push_back(std::move(S));
+  }
+  char phase[64] = {0};
+  sdpa.getPhaseString(phase);
+  const SDPA::PhaseType phase_value = sdpa.getPhaseValue();
+  out.details = {{"phase", phase},
+                 {"primal_obj", sdpa.getPrimalObj()},
+                 {"dual_obj", sdpa.getDualObj()},
+                 {"primal_error", sdpa.getPrimalError()},
+                 {"dual_error", sdpa.getDualError()},
+                 {"digits", sdpa.getDigits()},
+                 {"mu", sdpa.getMu()},
+                 {"iterations", out.iterations}};
+  out.message = fmt::format("SDPA phase {} after {} iterations: c'x {:.9g}, F0.Y {:.9g}", phase, out.iterations,
+                            sdpa.getPrimalObj(), sdpa.getDualObj());
+  sdpa.terminate();
+
+  // SDPA phases name SDPA's primal (= our LMI problem) first:
+  //   pdOPT       both feasible, gap met                           -> kOptimal
+  //   pINF_dFEAS  primal (our LMI) infeasible                      -> kInfeasible (if Y certifies it)
+  //   dUNBD       dual unbounded, i.e. our LMI infeasible          -> kInfeasible (if Y certifies it)
+  //   pFEAS_dINF  dual infeasible, i.e. our objective unbounded    -> kUnbounded
+  //   pUNBD       primal unbounded                                 -> kUnbounded
+  //   pdINF       both infeasible                                  -> kInfeasible if Y certifies it, else trouble
+  //   pdFEAS, pFEAS, dFEAS, noINFO: stopped early                  -> kIterationLimit at the limit, else kInaccurate
+  // An infeasibility label is never trusted alone: whichever label, if Y passes the certificate test the
+  // answer is kInfeasible (a certified LMI infeasibility cannot be unboundedness).
+  switch (phase_value) {
+    case SDPA::pdOPT: out.status = SdpStatus::kOptimal; break;
+    case SDPA::pINF_dFEAS:
+    case SDPA::dUNBD:
+    case SDPA::pdINF: out.status = SdpStatus::kInfeasible; break;
+    case SDPA::pFEAS_dINF:
+    case SDPA::pUNBD: out.status = SdpStatus::kUnbounded; break;
+    default:
+      out.status = out.iterations >= options.max_iterations ? SdpStatus::kIterationLimit : SdpStatus::kInaccurate;
+      break;
+  }
+  if (out.status == SdpStatus::kInfeasible) {
+    ConfirmInfeasibility(options, problem, out.X, &out);
+  } else if (out.status == SdpStatus::kUnbounded &&
+             InfeasibilityResidual(problem, out.X) <= options.infeasibility_tolerance) {
+    out.status = SdpStatus::kInfeasible;
+    out.message += " (relabelled: Y certifies that the LMI is infeasible)";
+  }
+  if (out.status == SdpStatus::kInfeasible) {
+    out.lower_bound = out.primal_value = std::numeric_limits<double>::infinity();
+  } else if (out.status == SdpStatus::kUnbounded) {
+    out.lower_bound = out.primal_value = -std::numeric_limits<double>::infinity();
+  }
+  AcceptNearOptimal(options, &out);
+  return out;
+}
+
+}  // namespace
+
+SdpSummary SdpaSolver::Solve(const SdpOptions& options, const LmiProblem& problem) {
+  SdpSummary out = SolveCanonical(options, problem, [&](const LmiProblem& p) { return SolveWithSdpa(options, p); });
+  out.solver = name();
+  if (!options.keep_dual_matrix) {
+    out.X.clear();
+    out.Z.clear();
+  }
+  return out;
+}
+
+}  // namespace hw::sdp
