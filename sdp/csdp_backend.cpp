@@ -259,12 +259,8 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
   }
   out.message = fmt::format("CSDP code {} ({}) after {} iterations: tr(F0 X) {:.9g}, c'y {:.9g}", ret,
                             ret >= 0 && ret <= 9 ? kMeaning[ret] : "unknown failure", out.iterations, pobj, dobj);
-  if (out.status == SdpStatus::kInfeasible) ConfirmInfeasibility(options, problem, out.X, &out);
-  if (out.status == SdpStatus::kInfeasible) {
-    out.lower_bound = out.primal_value = std::numeric_limits<double>::infinity();
-  } else if (out.status == SdpStatus::kUnbounded) {
-    out.lower_bound = out.primal_value = -std::numeric_limits<double>::infinity();
-  }
+  if (out.status == SdpStatus::kInfeasible || out.status == SdpStatus::kUnbounded)
+    ResolveInfeasibilityClaim(options, problem, &out);
   AcceptNearOptimal(options, &out);
   return out;
 }

@@ -73,6 +73,51 @@ void ConfirmInfeasibility(const SdpOptions& options, const LmiProblem& problem, 
   }
 }
 
+double UnboundednessResidual(const LmiProblem& problem, const std::vector<double>& d) {
+  const double inf = std::numeric_limits<double>::infinity();
+  if (static_cast<int>(d.size()) != problem.num_vars()) return inf;
+  double norm = 0.0;
+  for (double v : d) norm += v * v;
+  norm = std::sqrt(norm);
+  if (!(norm > 0) || !std::isfinite(norm)) return inf;
+  double cd = 0.0;
+  for (std::size_t i = 0; i < d.size(); ++i) cd += problem.c[i] * d[i] / norm;
+  if (!(cd < 0)) return inf;
+  double worst = 0.0;
+  for (std::size_t b = 0; b < problem.blocks.size(); ++b) {
+    const int n = problem.blocks[b].size;
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, n);
+    for (std::size_t i = 1; i < problem.F.size(); ++i)
+      for (const auto& e : problem.F[i])
+        if (e.block == static_cast<int>(b)) {
+          S(e.row, e.col) += e.value * d[i - 1] / norm;
+          if (e.row != e.col) S(e.col, e.row) += e.value * d[i - 1] / norm;
+        }
+    worst = std::min(worst, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S, Eigen::EigenvaluesOnly).eigenvalues()(0));
+  }
+  return -worst / -cd;
+}
+
+void ResolveInfeasibilityClaim(const SdpOptions& options, const LmiProblem& problem, SdpSummary* s) {
+  const double r_inf = InfeasibilityResidual(problem, s->X);
+  const double r_unb = UnboundednessResidual(problem, s->y);
+  s->details["infeasibility_residual"] = std::isfinite(r_inf) ? r_inf : -1.0;
+  s->details["unboundedness_residual"] = std::isfinite(r_unb) ? r_unb : -1.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  if (r_inf <= options.infeasibility_tolerance) {
+    s->status = SdpStatus::kInfeasible;
+    s->lower_bound = s->primal_value = inf;
+    s->message += fmt::format(" -> infeasible: X certifies it (sum|F_i.X| / F_0.X = {:.2e})", r_inf);
+  } else if (r_unb <= options.infeasibility_tolerance) {
+    s->status = SdpStatus::kUnbounded;
+    s->lower_bound = s->primal_value = -inf;
+    s->message += fmt::format(" -> unbounded: y is a descent ray (lambda_min^- / -c'd = {:.2e})", r_unb);
+  } else {
+    s->status = SdpStatus::kNumericalTrouble;
+    s->message += " -> neither an infeasibility certificate nor a descent ray could be checked";
+  }
+}
+
 void AcceptNearOptimal(const SdpOptions& options, SdpSummary* s) {
   if (s->status != SdpStatus::kInaccurate) return;
   if (s->relative_gap <= options.acceptable_gap && s->primal_infeasibility <= options.acceptable_gap &&

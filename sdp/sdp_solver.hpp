@@ -77,6 +77,14 @@ double InfeasibilityResidual(const LmiProblem& problem, const std::vector<Eigen:
 void ConfirmInfeasibility(const SdpOptions& options, const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X,
                           SdpSummary* summary);
 
+// For a candidate ray d (normalised inside): max(0, -lambda_min(sum d_i F_i)) / (-c^T d); infinity unless
+// c^T d < 0. Small means d is (nearly) a direction along which c^T y decreases without leaving the LMI.
+double UnboundednessResidual(const LmiProblem& problem, const std::vector<double>& d);
+// Settles a backend's claim of infeasibility or unboundedness by the certificates, never by the label:
+// X certifies infeasibility -> kInfeasible; else y is a ray -> kUnbounded; else kNumericalTrouble.
+// kUnbounded does not separately prove that the LMI is feasible (either way no bound is usable).
+void ResolveInfeasibilityClaim(const SdpOptions& options, const LmiProblem& problem, SdpSummary* summary);
+
 // Promotes kInaccurate to kOptimal when the gap and infeasibilities are within options.acceptable_gap.
 void AcceptNearOptimal(const SdpOptions& options, SdpSummary* summary);
 

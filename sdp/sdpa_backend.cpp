@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <iostream>
+#include <sstream>
 #include <limits>
 #include <mutex>
 
@@ -25,6 +27,27 @@ std::mutex& SdpaMutex() {
   return mu;
 }
 
+// SDPA writes warnings ("pdINF criteria", "Strange behavior : primal < dual", "maxIteration is reached")
+// to std::cout through its rMessage macro, whatever setDisplay() says. While a quiet solve runs (solves
+// are serialised, so one at a time) std::cout's buffer is swapped for a string that ends up in
+// details["messages"]. Consequence: other threads must not write to std::cout during SDPA solves
+// (hwbounds prints with fmt/printf to stdout or to stderr, which this does not touch).
+class CoutCapture {
+ public:
+  explicit CoutCapture(bool active) : active_(active) {
+    if (active_) saved_ = std::cout.rdbuf(buffer_.rdbuf());
+  }
+  ~CoutCapture() {
+    if (active_) std::cout.rdbuf(saved_);
+  }
+  std::string text() const { return buffer_.str(); }
+
+ private:
+  bool active_;
+  std::ostringstream buffer_;
+  std::streambuf* saved_ = nullptr;
+};
+
 // Jobs run in parallel in our own pool: BLAS (OpenBLAS, shared with CSDP's -lblas alternative) gets
 // one thread, so two solves never oversubscribe the cores. Set once, process-wide.
 void SingleThreadedBlas() {
@@ -37,6 +60,7 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   SdpSummary out;
   SingleThreadedBlas();
   std::lock_guard<std::mutex> lock(SdpaMutex());
+  CoutCapture capture(!options.verbose);
   const auto t0 = Clock::now();
   const int m = problem.num_vars();
   const int nblocks = static_cast<int>(problem.blocks.size());
@@ -108,6 +132,7 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   out.message = fmt::format("SDPA phase {} after {} iterations: c'x {:.9g}, F0.Y {:.9g}", phase, out.iterations,
                             sdpa.getPrimalObj(), sdpa.getDualObj());
   sdpa.terminate();
+  if (!capture.text().empty()) out.details["messages"] = capture.text();
 
   // SDPA phases name SDPA's primal (= our LMI problem) first:
   //   pdOPT       both feasible, gap met                           -> kOptimal
@@ -115,10 +140,10 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   //   dUNBD       dual unbounded, i.e. our LMI infeasible          -> kInfeasible (if Y certifies it)
   //   pFEAS_dINF  dual infeasible, i.e. our objective unbounded    -> kUnbounded
   //   pUNBD       primal unbounded                                 -> kUnbounded
-  //   pdINF       both infeasible                                  -> kInfeasible if Y certifies it, else trouble
+  //   pdINF       both infeasible                                  -> by the certificates (see below)
   //   pdFEAS, pFEAS, dFEAS, noINFO: stopped early                  -> kIterationLimit at the limit, else kInaccurate
-  // An infeasibility label is never trusted alone: whichever label, if Y passes the certificate test the
-  // answer is kInfeasible (a certified LMI infeasibility cannot be unboundedness).
+  // No infeasibility/unboundedness label is trusted alone (SDPA said pdINF on a plainly unbounded test
+  // problem): ResolveInfeasibilityClaim() decides by the certificates Y (infeasibility) and x (ray).
   switch (phase_value) {
     case SDPA::pdOPT: out.status = SdpStatus::kOptimal; break;
     case SDPA::pINF_dFEAS:
@@ -130,18 +155,8 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
       out.status = out.iterations >= options.max_iterations ? SdpStatus::kIterationLimit : SdpStatus::kInaccurate;
       break;
   }
-  if (out.status == SdpStatus::kInfeasible) {
-    ConfirmInfeasibility(options, problem, out.X, &out);
-  } else if (out.status == SdpStatus::kUnbounded &&
-             InfeasibilityResidual(problem, out.X) <= options.infeasibility_tolerance) {
-    out.status = SdpStatus::kInfeasible;
-    out.message += " (relabelled: Y certifies that the LMI is infeasible)";
-  }
-  if (out.status == SdpStatus::kInfeasible) {
-    out.lower_bound = out.primal_value = std::numeric_limits<double>::infinity();
-  } else if (out.status == SdpStatus::kUnbounded) {
-    out.lower_bound = out.primal_value = -std::numeric_limits<double>::infinity();
-  }
+  if (out.status == SdpStatus::kInfeasible || out.status == SdpStatus::kUnbounded)
+    ResolveInfeasibilityClaim(options, problem, &out);
   AcceptNearOptimal(options, &out);
   return out;
 }
