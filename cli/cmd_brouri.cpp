@@ -140,7 +140,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
     std::string plan, data, out, y_col = "y", down_border = "leading-and-root";
     int degree = 0, max_degree = 9, harmonic = 0;
     double plateau_sigmas = 5.0;
-    bool no_zoh = false;
+    bool no_zoh = false, joint_refit = false;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = brouri.add_subcommand("estimate", "Estimate from recordings of a plan (stage 1 or 2, read from the plan)");
@@ -152,6 +152,8 @@ void AddBrouriEstimate(CLI::App& brouri) {
   cmd->add_option("--plateau-sigmas", o->plateau_sigmas, "stage 1: plateau test threshold in standard errors");
   cmd->add_option("--down-border", o->down_border,
                   "stage 1: S^d, d- reading: leading-and-root | paper-coefficients | root-and-slope");
+  cmd->add_flag("--joint-refit", o->joint_refit,
+                "stage 1: refit h, d+, S^d, d- to both borders' points jointly (not in the paper; needs p + 4 points)");
   cmd->add_option("--harmonic", o->harmonic, "stage 2: harmonic k used for |G| (0 = degree of h, eq. 37)")
       ->check(CLI::Range(0, 15));
   cmd->add_flag("--no-zoh-correction", o->no_zoh, "stage 2: do not correct for the hold (sinc gain, Ts/2 delay)");
@@ -169,6 +171,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
       opt.max_degree = o->max_degree;
       opt.plateau_sigmas = o->plateau_sigmas;
       opt.down_border = DownBorderMethodFromString(o->down_border);
+      opt.joint_refit = o->joint_refit;
       const auto rec = ReadRecording(path_of(plan.file), plan.sample_time, o->y_col);
       Summary s;
       const auto est = EstimateFromSteps(plan, opt, rec.u, rec.y, &s);

@@ -102,15 +102,16 @@ TEST(BrouriEstimator, NoiseFreeRecoversTheTruth) {
   EXPECT_EQ(e.kind, OperatorKind::kBacklash);
   EXPECT_EQ(e.j_a, 4);
   EXPECT_EQ(e.j_d, 5);
-  EXPECT_NEAR(e.params.offset_up, 0.5, 1e-7);
-  EXPECT_NEAR(e.params.slope_down, 1.0, 1e-6);
-  EXPECT_NEAR(e.params.offset_down, -0.5, 1e-7);
-  EXPECT_NEAR(e.d_down_coefficient, -0.5, 1e-6);  // the paper's reading agrees without noise
-  for (int i = 0; i <= 5; ++i) EXPECT_NEAR(e.h[i], truth.h[i], 1e-5) << "h coefficient " << i;
+  EXPECT_NEAR(e.params.offset_up, 0.5, 1e-9);
+  EXPECT_NEAR(e.params.slope_down, 1.0, 1e-8);
+  EXPECT_NEAR(e.params.offset_down, -0.5, 1e-9);
+  EXPECT_NEAR(e.d_down_coefficient, -0.5, 1e-8);  // the paper's reading agrees without noise
+  for (int i = 0; i <= 5; ++i) EXPECT_NEAR(e.h[i], truth.h[i], 1e-7) << "h coefficient " << i;
+  // Left: the staircase's images aliasing onto the fundamental, O(samples per period^-4).
   for (const auto& p : r.points) {
     const auto g = truth.g.Response(p.omega);
-    EXPECT_NEAR(p.gain, std::abs(g), 2e-4) << "omega " << p.omega;
-    EXPECT_NEAR(p.phase, -std::arg(g), 2e-4) << "omega " << p.omega;
+    EXPECT_NEAR(p.gain, std::abs(g), 5e-5) << "omega " << p.omega;
+    EXPECT_NEAR(p.phase, -std::arg(g), 5e-5) << "omega " << p.omega;
     EXPECT_LT(p.fit_residual, 1e-3);
   }
 }
@@ -240,6 +241,28 @@ TEST(BrouriEstimator, BacklashInverseInputIsDetectedAndIdentified) {
     const double e_coarse = std::abs(coarse.points[i].gain - std::abs(g)), e_fine = std::abs(p.gain - std::abs(g));
     if (e_coarse > 1e-3) EXPECT_LT(e_fine, e_coarse / 2.5) << "4x finer sampling should cut the error ~4x";
   }
+}
+
+TEST(BrouriEstimator, JointRefitIsExactWithoutNoiseAndTightensSdWithNoise) {
+  auto sys = BacklashHwSystem::PaperExample();
+  auto c = ShortConfig();
+  c.omegas = {0.05};
+  c.nonlinear.joint_refit = true;
+  sys.noise_std = 0;
+  const auto exact = RunWorkflow(sys, c, 1);
+  EXPECT_TRUE(exact.nonlinear.joint_refit);
+  EXPECT_NEAR(exact.nonlinear.params.slope_down, 1.0, 1e-7);
+  EXPECT_NEAR(exact.nonlinear.params.offset_down, -0.5, 1e-7);
+  EXPECT_NEAR(exact.nonlinear.h[5], 6.4, 1e-5);
+  sys.noise_std = 0.01;
+  double rms_paper = 0, rms_joint = 0;
+  for (int s = 0; s < 12; ++s) {
+    c.nonlinear.joint_refit = false;
+    rms_paper += std::pow(RunWorkflow(sys, c, 7 + s).nonlinear.params.slope_down - 1.0, 2);
+    c.nonlinear.joint_refit = true;
+    rms_joint += std::pow(RunWorkflow(sys, c, 7 + s).nonlinear.params.slope_down - 1.0, 2);
+  }
+  EXPECT_LT(rms_joint, rms_paper / 2) << "MSE of S^d: paper " << rms_paper / 12 << ", joint " << rms_joint / 12;
 }
 
 TEST(BrouriEstimator, DegreeIsSelectedFromTheData) {

@@ -65,8 +65,8 @@ nlohmann::json StepPlan::to_json() const {
 }
 
 StepPlan StepPlan::from_json(const nlohmann::json& j) {
-  StepPlan p;
-  try {
+  return ParseValidated<StepPlan>("step plan", [&] {
+    StepPlan p;
     p.sample_time = j.at("sample_time").get<double>();
     p.hold_samples = j.at("hold_samples").get<int>();
     p.average_samples = j.at("average_samples").get<int>();
@@ -74,12 +74,8 @@ StepPlan StepPlan::from_json(const nlohmann::json& j) {
     p.levels_up = j.at("levels_up").get<std::vector<double>>();
     p.levels_down = j.at("levels_down").get<std::vector<double>>();
     p.file = j.value("file", std::string("steps.csv"));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("step plan JSON: ") + e.what());
-  }
-  std::string err;
-  if (!p.IsValid(&err)) throw InputError("step plan: " + err);
-  return p;
+    return p;
+  });
 }
 
 StepPlan MakeStepPlan(std::vector<double> levels_up, std::vector<double> levels_down, double reset_level,
@@ -142,8 +138,8 @@ nlohmann::json SinePlan::to_json() const {
 }
 
 SinePlan SinePlan::from_json(const nlohmann::json& j) {
-  SinePlan p;
-  try {
+  return ParseValidated<SinePlan>("sine plan", [&] {
+    SinePlan p;
     p.amplitude = j.at("amplitude").get<double>();
     for (const auto& e : j.at("experiments")) {
       SineExperiment x;
@@ -155,12 +151,8 @@ SinePlan SinePlan::from_json(const nlohmann::json& j) {
       p.experiments.push_back(x);
     }
     p.nonlinear = NonlinearEstimate::from_json(j.at("nonlinear"));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("sine plan JSON: ") + e.what());
-  }
-  std::string err;
-  if (!p.IsValid(&err)) throw InputError("sine plan: " + err);
-  return p;
+    return p;
+  });
 }
 
 SinePlan MakeSinePlan(const NonlinearEstimate& nonlinear, const std::vector<double>& omegas, double amplitude,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
@@ -130,6 +131,70 @@ double RootNearInterval(const std::vector<double>& q, double lo, double hi, cons
   return best;
 }
 
+// h (no constant term) by linear least squares for fixed border lines; returns the residual vector.
+Eigen::VectorXd JointResidual(const std::vector<double>& ua, const std::vector<double>& xa,
+                              const std::vector<double>& ud, const std::vector<double>& xd, int p,
+                              const Eigen::Vector3d& theta, Eigen::VectorXd* coeffs) {
+  const Eigen::Index n = static_cast<Eigen::Index>(ua.size() + ud.size());
+  Eigen::MatrixXd a(n, p);
+  Eigen::VectorXd x(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const bool up = i < static_cast<Eigen::Index>(ua.size());
+    const double w = up ? ua[i] - theta(0) : theta(1) * (ud[i - ua.size()] - theta(2));
+    double pw = w;
+    for (int k = 0; k < p; ++k, pw *= w) a(i, k) = pw;
+    x(i) = up ? xa[i] : xd[i - ua.size()];
+  }
+  const Eigen::VectorXd c = a.colPivHouseholderQr().solve(x);
+  if (coeffs) *coeffs = c;
+  return x - a * c;
+}
+
+void JointRefit(const std::vector<double>& ua, const std::vector<double>& xa, const std::vector<double>& ud,
+                const std::vector<double>& xd, int p, OperatorLines* lines, std::vector<double>* h) {
+  Eigen::Vector3d theta(lines->root_up, lines->slope_down, lines->root_down);
+  Eigen::VectorXd r = JointResidual(ua, xa, ud, xd, p, theta, nullptr);
+  double cost = r.squaredNorm(), lambda = 1e-3;
+  for (int it = 0; it < 200; ++it) {
+    Eigen::MatrixXd jac(r.size(), 3);
+    for (int k = 0; k < 3; ++k) {
+      const double step = 1e-7 * (1.0 + std::abs(theta(k)));
+      Eigen::Vector3d t = theta;
+      t(k) += step;
+      jac.col(k) = (JointResidual(ua, xa, ud, xd, p, t, nullptr) - r) / step;
+    }
+    const Eigen::Matrix3d jtj = jac.transpose() * jac;
+    const Eigen::Vector3d g = jac.transpose() * r;
+    bool improved = false;
+    for (int tries = 0; tries < 20 && !improved; ++tries) {
+      Eigen::Matrix3d m = jtj;
+      m.diagonal() *= 1.0 + lambda;
+      const Eigen::Vector3d delta = -m.ldlt().solve(g);
+      const Eigen::Vector3d t = theta + delta;
+      if (!(t(1) > 0)) {
+        lambda *= 10;
+        continue;
+      }
+      const Eigen::VectorXd rn = JointResidual(ua, xa, ud, xd, p, t, nullptr);
+      if (rn.squaredNorm() < cost) {
+        const double gain = cost - rn.squaredNorm();
+        theta = t, r = rn, cost = rn.squaredNorm(), lambda = std::max(lambda / 10, 1e-12), improved = true;
+        if (gain < 1e-15 * (1 + cost) && delta.norm() < 1e-12) it = 1 << 20;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved) break;
+  }
+  Eigen::VectorXd c;
+  JointResidual(ua, xa, ud, xd, p, theta, &c);
+  lines->root_up = theta(0);
+  lines->slope_down = theta(1);
+  lines->root_down = theta(2);
+  h->assign(p + 1, 0.0);
+  for (int k = 0; k < p; ++k) (*h)[k + 1] = c(k);
+}
+
 }  // namespace
 
 void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& reset,
@@ -220,8 +285,21 @@ void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& 
   if (options.down_border == DownBorderMethod::kRootAndSlope) s_down = est->s_down_slope, d_down = est->d_down_root;
   if (!(s_down > 0)) throw InputError(fmt::format("estimated S^d = {} is not positive", s_down));
   est->lines = {1.0, d_up, s_down, d_down};
+  est->paper_lines = est->lines;
+  if (options.joint_refit) {
+    if (na + nd < p + 4)
+      throw InputError(fmt::format("joint refit: {} border points cannot determine h (degree {}) and 3 border "
+                                   "parameters with any redundancy; need at least {}",
+                                   na + nd, p, p + 4));
+    JointRefit(ua, xa, ud, xd, p, &est->lines, &est->h);
+    est->q_up = PolyShift(est->h, -est->lines.root_up);
+    std::vector<double> scaled = est->h;
+    for (int i = 0; i <= p; ++i) scaled[i] *= std::pow(est->lines.slope_down, i);
+    est->q_down = PolyShift(scaled, -est->lines.root_down);
+    est->joint_refit = true;
+  }
   // A backlash's ascending border lies right of its descending one; a backlash-inverse's lies left.
-  est->kind = d_up >= d_down ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
+  est->kind = est->lines.root_up >= est->lines.root_down ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
   if (est->kind == OperatorKind::kBacklashInverse && (est->j_a > 0 || est->j_d > 0))
     est->warnings += fmt::format("line order says backlash-inverse but plateaus were seen (j_a = {}, j_d = {}). ",
                                  est->j_a, est->j_d);
@@ -230,6 +308,7 @@ void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& 
   summary->message = fmt::format("{} detected; p = {}, j_a = {}, j_d = {}; d+ = {:.4f}, S^d = {:.4f}, d- = {:.4f}",
                                  ToString(est->kind), p, est->j_a, est->j_d, est->params.offset_up,
                                  est->params.slope_down, est->params.offset_down);
+  if (est->joint_refit) summary->message += " (joint refit of both borders)";
   if (!est->warnings.empty()) summary->message += "; warnings: " + est->warnings;
 }
 
@@ -259,6 +338,9 @@ nlohmann::json NonlinearEstimate::to_json() const {
       {"leading_and_root", {{"S_d", s_down_leading}, {"d_minus", d_down_root}}},
       {"root_and_slope", {{"S_d", s_down_slope}, {"d_minus", d_down_root}}}};
   j["h"] = h;
+  j["joint_refit"] = joint_refit;
+  j["paper_lines"] = {{"slope_up", paper_lines.slope_up}, {"root_up", paper_lines.root_up},
+                      {"slope_down", paper_lines.slope_down}, {"root_down", paper_lines.root_down}};
   j["q_up"] = q_up;
   j["q_down"] = q_down;
   j["reset"] = HoldJson(reset);

@@ -59,6 +59,11 @@ struct NonlinearOptions {
   double plateau_sigmas = 5.0; // a hold belongs to the plateau if within this many standard errors
   double plateau_abs_tol = 0.0;// plus this absolute tolerance (noise-free data: leave 0)
   DownBorderMethod down_border = DownBorderMethod::kLeadingAndRoot;
+  // Not in the paper: after its estimates, refit h, d+, S^d, d- jointly to BOTH borders' points
+  // (X_j = h(U_j - d+) ascending, h(S^d (U_j - d-)) descending; h(0) = 0; Levenberg-Marquardt on the
+  // three border parameters, h by linear least squares). Uses all points for h, so h^ is no longer
+  // extrapolated over the descending range. Needs at least p + 3 border points in all.
+  bool joint_refit = false;
   bool IsValid(std::string* error) const;
 };
 
@@ -74,6 +79,8 @@ struct NonlinearEstimate {
   // The three readings of the descending border (see DownBorderMethod): {S^d, d-} each.
   double s_down_leading = 0.0, d_down_coefficient = 0.0, d_down_root = 0.0, s_down_slope = 0.0;
   BacklashParams params;                         // of the detected kind, normalised (S^a = 1)
+  bool joint_refit = false;                      // params and h come from the joint refit
+  OperatorLines paper_lines;                     // the paper's two-step lines (before any refit)
   std::string warnings;
 
   nlohmann::json to_json() const;

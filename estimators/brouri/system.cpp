@@ -222,11 +222,11 @@ nlohmann::json BacklashHwSystem::to_json() const {
 }
 
 BacklashHwSystem BacklashHwSystem::from_json(const nlohmann::json& j) {
-  BacklashHwSystem s;
-  try {
-    const auto op = j.value("operator", std::string("backlash"));
-    if (op != "backlash" && op != "backlash-inverse")
-      throw InputError(fmt::format("system JSON: operator '{}' must be 'backlash' or 'backlash-inverse'", op));
+  const auto op = j.value("operator", std::string("backlash"));
+  if (op != "backlash" && op != "backlash-inverse")
+    throw InputError(fmt::format("system JSON: operator '{}' must be 'backlash' or 'backlash-inverse'", op));
+  return ParseValidated<BacklashHwSystem>("system", [&] {
+    BacklashHwSystem s;
     s.kind = op == "backlash" ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
     s.backlash = {j.at("S_a").get<double>(), j.at("d_plus").get<double>(), j.at("S_d").get<double>(),
                   j.at("d_minus").get<double>()};
@@ -234,12 +234,8 @@ BacklashHwSystem BacklashHwSystem::from_json(const nlohmann::json& j) {
     s.g.den = j.at("den").get<std::vector<double>>();
     s.h = j.at("h").get<std::vector<double>>();
     s.noise_std = j.value("noise_std", 0.0);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("system JSON: ") + e.what());
-  }
-  std::string err;
-  if (!s.IsValid(&err)) throw InputError("system JSON: " + err);
-  return s;
+    return s;
+  });
 }
 
 SimulationResult Simulate(const BacklashHwSystem& system, const std::vector<double>& u, double sample_time,

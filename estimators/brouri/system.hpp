@@ -13,7 +13,24 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "core/csv_table.hpp"
+
 namespace hw::brouri {
+
+// Runs parse() (JSON access that may throw), turns JSON errors into InputError naming `what`, and
+// checks the result's IsValid.
+template <class T, class Parse>
+T ParseValidated(const std::string& what, Parse&& parse) {
+  T value;
+  try {
+    value = parse();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(what + " JSON: " + e.what());
+  }
+  std::string err;
+  if (!value.IsValid(&err)) throw InputError(what + ": " + err);
+  return value;
+}
 
 // Polynomials are ascending coefficient vectors: p(x) = sum_i c[i] x^i.
 double PolyEval(const std::vector<double>& c, double x);
