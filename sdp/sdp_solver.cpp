@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <tuple>
 #include <stdexcept>
 
@@ -10,6 +11,8 @@
 
 #include "sdp/csdp_backend.hpp"
 #include "sdp/sdpa_backend.hpp"
+
+extern "C" void openblas_set_num_threads(int);
 
 namespace hw::sdp {
 
@@ -133,6 +136,14 @@ double RelativeGap(double primal, double dual) {
 
 namespace {
 
+// Solves run in parallel in our own job pool: BLAS (OpenBLAS; Debian's libblas.so.3 alternative forwards
+// to the same libopenblas.so.0, so CSDP's -lblas and SDPA's -lopenblas share one setting) gets one
+// thread, so concurrent solves never oversubscribe the cores. Process-wide, set once.
+void SingleThreadedBlas() {
+  static std::once_flag once;
+  std::call_once(once, [] { openblas_set_num_threads(1); });
+}
+
 // Sums duplicate entries and drops zeros, matrix by matrix.
 std::vector<Entry> Canonical(const std::vector<Entry>& entries) {
   std::map<std::tuple<int, int, int>, double> sum;
@@ -190,6 +201,7 @@ SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
     out.message = error;
     return out;
   }
+  SingleThreadedBlas();
   LmiProblem reduced;
   reduced.blocks = problem.blocks;
   reduced.objective_offset = problem.objective_offset;

@@ -10,8 +10,6 @@
 #include <fmt/format.h>
 #include <sdpa_call.h>
 
-extern "C" void openblas_set_num_threads(int);
-
 namespace hw::sdp {
 namespace {
 
@@ -48,17 +46,9 @@ class CoutCapture {
   std::streambuf* saved_ = nullptr;
 };
 
-// Jobs run in parallel in our own pool: BLAS (OpenBLAS, shared with CSDP's -lblas alternative) gets
-// one thread, so two solves never oversubscribe the cores. Set once, process-wide.
-void SingleThreadedBlas() {
-  static std::once_flag once;
-  std::call_once(once, [] { openblas_set_num_threads(1); });
-}
-
 // Expects the canonical problem of SolveCanonical(): no duplicates, no zeros, every F_i non-empty.
 SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   SdpSummary out;
-  SingleThreadedBlas();
   std::lock_guard<std::mutex> lock(SdpaMutex());
   CoutCapture capture(!options.verbose);
   const auto t0 = Clock::now();

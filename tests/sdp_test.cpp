@@ -16,6 +16,8 @@
 #include "sdp/sdp_solver.hpp"
 #include "sdp/sdpa_format.hpp"
 
+extern "C" int openblas_get_num_threads();
+
 namespace hw::sdp {
 namespace {
 
@@ -297,6 +299,11 @@ TEST_P(BackendTest, ConcurrentSolvesMatchSerialOnes) {
     EXPECT_NEAR(parallel[k].lower_bound, serial[k].lower_bound, 1e-12 * (1 + std::abs(serial[k].lower_bound)));
     EXPECT_NEAR(parallel[k].primal_value, serial[k].primal_value, 1e-12 * (1 + std::abs(serial[k].primal_value)));
   }
+}
+
+TEST_P(BackendTest, BlasRunsSingleThreaded) {
+  ASSERT_TRUE(Solve(TwoByTwo()).usable());
+  EXPECT_EQ(openblas_get_num_threads(), 1);  // jobs are parallel in our pool, never inside BLAS
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, BackendTest, ::testing::Values("csdp", "sdpa"),
