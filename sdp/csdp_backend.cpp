@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <new>
 
 #include <fmt/format.h>
@@ -22,9 +23,12 @@ extern "C" {
 // the calling thread travel in a thread_local. user_exit(), CSDP's documented per-iteration hook, is
 // replaced the same way to count iterations (easy_sdp does not return the count).
 //
-// Thread safety: libsdp 6.2 has no mutable global data (checked with nm: no .data/.bss symbols) and,
-// with the two replacements above, touches no file; concurrent solves on different threads are safe
-// and are not serialised. BLAS is set to one thread by the caller side (see SdpaSolver / job pool).
+// Thread safety: libsdp 6.2 as built by Debian is NOT safe to run concurrently. op_o() (the Schur
+// complement assembly) keeps a function-static work array ("b work.0" in `nm libsdp.a`), allocated on the
+// first iteration and freed at the end of a solve; CSDP makes it thread-private only when built with
+// OpenMP, which Debian's build is not. Two concurrent solves read each other's freed memory and free it
+// twice (valgrind showed exactly that in the concurrency test). Every easy_sdp() call in the process is
+// therefore serialised by CsdpMutex(); setup, result extraction and certificate checks run outside it.
 // ---------------------------------------------------------------------------------------------------
 namespace {
 
@@ -75,6 +79,11 @@ namespace hw::sdp {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+std::mutex& CsdpMutex() {
+  static std::mutex mu;
+  return mu;
+}
 
 template <typename T>
 T* alloc(std::size_t n) {  // CSDP frees with free(): allocate with calloc
@@ -188,6 +197,7 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
   const auto t1 = Clock::now();
   int ret;
   {
+    std::lock_guard<std::mutex> lock(CsdpMutex());
     tls_csdp.active = true;
     CsdpDefaults(&tls_csdp.params, &tls_csdp.printlevel);
     tls_csdp.params.axtol = options.feasibility_tolerance;   // relative primal infeasibility (our F_i . X = c_i)
