@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -380,6 +382,43 @@ TEST(SdpaFormat, RoundTripGivesTheSameValue) {
     ASSERT_TRUE(a.usable() && b.usable());
     EXPECT_DOUBLE_EQ(a.lower_bound, b.lower_bound);
   }
+  std::filesystem::remove_all(dir);
+}
+
+// Reads the first number after `key` in a text file; NaN when absent.
+double NumberAfter(const std::string& path, const std::string& key) {
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(key);
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(text.c_str() + at + key.size(), nullptr);
+}
+
+// Cross-check with the stand-alone `csdp` and `sdpa` programs on a written file. Skipped (not failed)
+// where the programs are not installed: the library tests above do not depend on them.
+TEST(SdpaFormat, WrittenFileAgreesWithTheSolverPrograms) {
+  if (std::system("command -v csdp >/dev/null 2>&1 && command -v sdpa >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "csdp/sdpa programs not installed";
+  const auto dir = std::filesystem::temp_directory_path() / ("hw_sdp_bin_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto p = RandomProblem(31, 8);
+  p.objective_offset = 0.0;  // the programs do not know our offset comment
+  WriteSdpaSparse((dir / "p.dat-s").string(), p);
+  const std::string d = dir.string();
+  ASSERT_EQ(std::system(("cd " + d + " && csdp p.dat-s p.sol > csdp.log 2>&1").c_str()), 0);
+  ASSERT_EQ(std::system(("cd " + d + " && sdpa p.dat-s sdpa.out > sdpa.log 2>&1").c_str()), 0);
+  const double csdp_primal = NumberAfter(d + "/csdp.log", "Primal objective value:");  // tr(F0 X): our bound
+  const double csdp_dual = NumberAfter(d + "/csdp.log", "Dual objective value:");      // c'y
+  const double sdpa_primal = NumberAfter(d + "/sdpa.out", "objValPrimal =");           // c'x
+  const double sdpa_dual = NumberAfter(d + "/sdpa.out", "objValDual   =");             // F0 . Y
+  const auto a = MakeSolver("csdp")->Solve({}, p);
+  const auto b = MakeSolver("sdpa")->Solve({}, p);
+  ASSERT_TRUE(a.usable() && b.usable());
+  const double tol = 1e-6 * std::max(1.0, std::abs(a.lower_bound));
+  EXPECT_NEAR(a.lower_bound, csdp_primal, tol);
+  EXPECT_NEAR(a.primal_value, csdp_dual, tol);
+  EXPECT_NEAR(b.primal_value, sdpa_primal, tol);
+  EXPECT_NEAR(b.lower_bound, sdpa_dual, tol);
   std::filesystem::remove_all(dir);
 }
 
