@@ -85,6 +85,8 @@ struct DiagnoseReport {
   CorrelationTest whiteness_nominal, input_corr_nominal, whiteness_augmented, input_corr_augmented;
   double validation_z = 0.0;
   std::string validation_note;
+  bool parameters_off = false;  // refitting the nominal alone already improves validation significantly
+  double refit_z = 0.0;         // paired z of that improvement
   FitFigures nominal, nominal_refit, augmented;  // on the validation recording
   FitFigures ident_nominal, ident_augmented;     // on the identification recording
   HwModel nominal_model, nominal_refit_model;

@@ -10,26 +10,12 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "diagnose/signal_stats.hpp"
 
 namespace hw::diagnose {
 namespace {
 
 using Vec = std::vector<double>;
-
-double Quantile(Vec v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = std::clamp(q, 0.0, 1.0) * (v.size() - 1);
-  const std::size_t i = static_cast<std::size_t>(pos);
-  const double f = pos - i;
-  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
-
-double Rms(const Vec& v) {
-  double s = 0.0;
-  for (double x : v) s += x * x;
-  return v.empty() ? 0.0 : std::sqrt(s / v.size());
-}
 
 Vec LogSpace(double lo, double hi, int n) {
   Vec v(n);

@@ -85,6 +85,8 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
               {"augmented", aug},
               {"on", "validation recording"},
               {"validation_paired_z", r.validation_z},
+              {"nominal_parameters_off", r.parameters_off},
+              {"nominal_refit_paired_z", r.refit_z},
               {"note", r.validation_note},
               {"identification", {{"nominal", r.ident_nominal.to_json()}, {"augmented", r.ident_augmented.to_json()}}}};
   j["residual_tests"] = {

@@ -6,21 +6,10 @@
 
 #include <fmt/format.h>
 
+#include "diagnose/signal_stats.hpp"
+
 namespace hw::diagnose {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (v.size() - 1))];
-}
 
 // Reversals with a dead band of 3 % of the signal's range, so that dither or noise does not count:
 // a reversal is a move of more than the band back from the extreme reached since the last one.

@@ -7,24 +7,12 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "diagnose/signal_stats.hpp"
 
 namespace hw::diagnose {
 namespace {
 
 using Vec = std::vector<double>;
-
-double Std(const Vec& v) {
-  double m = 0.0, s = 0.0;
-  for (double x : v) m += x;
-  m /= std::max<std::size_t>(1, v.size());
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / std::max<std::size_t>(1, v.size()));
-}
-
-double Quantile(Vec v, double q) {
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (v.size() - 1))];
-}
 
 // Low-passed random steps with a small dither: levels, rates and reversals all get exercised.
 Vec MakeInput(std::mt19937_64& rng, std::size_t n) {
@@ -48,12 +36,6 @@ Vec Contribution(const AugmentedModel& m, const HwModel& lin, const Vec& u, bool
   const Vec wl = lin.simulate(u);
   for (std::size_t t = 0; t < w.size(); ++t) w[t] -= wl[t];
   return w;
-}
-
-double Rms(const Vec& v) {
-  double s = 0.0;
-  for (double x : v) s += x * x;
-  return std::sqrt(s / std::max<std::size_t>(1, v.size()));
 }
 
 }  // namespace
@@ -116,7 +98,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
   const Vec u_id = MakeInput(rng, o.samples), u_va = MakeInput(rng, o.samples);
   const Vec w_lin = lin.simulate(u_id);
   const double frac = o.effect_fraction > 0 ? o.effect_fraction : 0.04 + 0.04 * U(rng);
-  const double target = frac * Std(w_lin);
+  const double target = frac * StdDev(w_lin);
 
   AugmentedModel truth{lin, {}};
   if (o.effect != Effect::kNone) {
@@ -152,7 +134,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
         case Effect::kQuantization:
           return {o.effect, loc, {std::max(1e-6, s * 0.5 * range)}};
         case Effect::kHysteresis:
-          return {o.effect, loc, {beta, s * 0.5 * Std(u_id)}};
+          return {o.effect, loc, {beta, s * 0.5 * StdDev(u_id)}};
         case Effect::kCoulombFriction:
           return {o.effect, loc, {s * 0.5 * force}};
         case Effect::kCubicStiffness:
