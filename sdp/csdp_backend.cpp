@@ -194,10 +194,13 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
   out.setup_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
   double pobj = 0.0, dobj = 0.0;
-  const auto t1 = Clock::now();
   int ret;
+  double wait_seconds = 0.0;
   {
+    const auto t_wait = Clock::now();
     std::lock_guard<std::mutex> lock(CsdpMutex());
+    wait_seconds = std::chrono::duration<double>(Clock::now() - t_wait).count();
+    const auto t1 = Clock::now();
     tls_csdp.active = true;
     CsdpDefaults(&tls_csdp.params, &tls_csdp.printlevel);
     tls_csdp.params.axtol = options.feasibility_tolerance;   // relative primal infeasibility (our F_i . X = c_i)
@@ -211,8 +214,8 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     ret = easy_sdp(d.n, d.k, d.C, d.a, d.constraints, 0.0, &d.X, &d.y, &d.Z, &pobj, &dobj);
     out.iterations = tls_csdp.iterations;
     tls_csdp.active = false;
+    out.solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
   }
-  out.solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
 
   out.lower_bound = pobj + problem.objective_offset;   // tr(C X) = F_0 . X
   out.primal_value = dobj + problem.objective_offset;  // a^T y = c^T y
@@ -242,7 +245,8 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     free_mat(work);
     std::free(workvec);
   }
-  out.details = {{"return_code", ret}, {"pobj", pobj}, {"dobj", dobj}, {"iterations", out.iterations}};
+  out.details = {{"return_code", ret}, {"pobj", pobj}, {"dobj", dobj}, {"iterations", out.iterations},
+                 {"lock_wait_seconds", wait_seconds}};
 
   // CSDP 6.2 return codes (CSDP user's guide; its primal is max tr(CX), A(X) = a, X >= 0):
   //   0 solved; 1 primal infeasible = no X = our problem unbounded below (y holds the ray);

@@ -54,7 +54,7 @@ struct SdpSummary {
   std::vector<Eigen::MatrixXd> Z;        // slack F(y), block by block
   int iterations = 0;
   double setup_seconds = 0.0;
-  double solve_seconds = 0.0;
+  double solve_seconds = 0.0;  // the solver call alone; waiting for the solver lock is details["lock_wait_seconds"]
   double relative_gap = 0.0;
   double primal_infeasibility = 0.0;  // of F_i . X = c_i
   double dual_infeasibility = 0.0;    // of the LMI at y
@@ -64,6 +64,9 @@ struct SdpSummary {
   bool usable() const { return status == SdpStatus::kOptimal; }
 };
 
+// Solve() may be called from several threads at once (each call owns its data), but both libraries keep
+// process-wide state, so each backend serialises its solver calls with a process-wide mutex (see
+// csdp_backend.cpp / sdpa_backend.cpp and docs/sdp.md): concurrency pays off for the work around solves.
 class SdpSolver {
  public:
   virtual ~SdpSolver() = default;

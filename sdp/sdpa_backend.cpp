@@ -49,7 +49,9 @@ class CoutCapture {
 // Expects the canonical problem of SolveCanonical(): no duplicates, no zeros, every F_i non-empty.
 SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   SdpSummary out;
+  const auto t_wait = Clock::now();
   std::lock_guard<std::mutex> lock(SdpaMutex());
+  const double wait_seconds = std::chrono::duration<double>(Clock::now() - t_wait).count();
   CoutCapture capture(!options.verbose);
   const auto t0 = Clock::now();
   const int m = problem.num_vars();
@@ -118,7 +120,8 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
                  {"dual_error", sdpa.getDualError()},
                  {"digits", sdpa.getDigits()},
                  {"mu", sdpa.getMu()},
-                 {"iterations", out.iterations}};
+                 {"iterations", out.iterations},
+                 {"lock_wait_seconds", wait_seconds}};
   out.message = fmt::format("SDPA phase {} after {} iterations: c'x {:.9g}, F0.Y {:.9g}", phase, out.iterations,
                             sdpa.getPrimalObj(), sdpa.getDualObj());
   sdpa.terminate();
