@@ -1,6 +1,7 @@
 #include "sdp/sdpa_format.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -41,7 +42,13 @@ LmiProblem ParseSdpaSparse(const std::string& text, const std::string& source) {
     ++line_no;
     if (line.empty() || line[0] == '*' || line[0] == '"') {
       const auto at = line.find("offset =");
-      if (at != std::string::npos) p.objective_offset = std::stod(line.substr(at + 8));
+      if (at != std::string::npos) {
+        const std::string rest = line.substr(at + 8);
+        char* end = nullptr;
+        p.objective_offset = std::strtod(rest.c_str(), &end);
+        if (end == rest.c_str() || !std::isfinite(p.objective_offset))
+          fail("expected a finite number after '* offset ='");
+      }
       continue;
     }
     if (stage < 4) {

@@ -459,6 +459,8 @@ TEST(SdpaFormat, ReaderErrorsNameFileAndLine) {
   expect_error("1\n1\n-2\n1.0\n0 1 1 2 1.0\n", "bad.dat-s:5:", "diagonal");
   expect_error("1\n1\n0\n", "bad.dat-s:3:", "block sizes");
   expect_error("1\n", "bad.dat-s", "header");
+  expect_error("* offset = abc\n" + header, "bad.dat-s:1:", "offset");
+  EXPECT_EQ(ParseSdpaSparse("* offset = -2.5\n" + header, "ok").objective_offset, -2.5);
   EXPECT_THROW(ReadSdpaSparse("/nonexistent/x.dat-s"), InputError);
 }
 
