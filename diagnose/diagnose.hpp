@@ -90,6 +90,7 @@ struct DiagnoseReport {
   FitFigures nominal, nominal_refit, augmented;  // on the validation recording
   FitFigures ident_nominal, ident_augmented;     // on the identification recording
   HwModel nominal_model, nominal_refit_model;
+  double nominal_refit_offset = 0.0;  // output offset estimated with the nominal refit
   AugmentedModel augmented_model;  // nominal refit + verdict block (block "none" when no verdict)
   // Signals for plots.
   std::vector<double> ident_nominal_sim, ident_augmented_sim, valid_nominal_sim, valid_augmented_sim;

@@ -251,6 +251,7 @@ bool AugmentedModel::simulate(const std::vector<double>& u, std::vector<double>*
   for (auto& v : z) {
     v = nominal.output(v);
     if (block.location == Location::kOutput) v = ApplyStaticBlock(block, v);
+    v += output_offset;
   }
   *y = std::move(z);
   return ok;
@@ -266,6 +267,7 @@ nlohmann::json AugmentedModel::to_json() const {
   nlohmann::json j = nominal.to_json();
   j["type"] = "augmented_hammerstein_wiener";
   j["effect_block"] = block.to_json();
+  j["output_offset"] = output_offset;
   return j;
 }
 
@@ -274,6 +276,7 @@ AugmentedModel AugmentedModel::from_json(const nlohmann::json& j) {
   nlohmann::json base = j;
   base["type"] = "hammerstein_wiener";
   m.nominal = HwModel::from_json(base);
+  if (j.contains("output_offset") && j["output_offset"].is_number()) m.output_offset = j["output_offset"].get<double>();
   if (j.contains("effect_block")) {
     try {
       const auto& e = j.at("effect_block");

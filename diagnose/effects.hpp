@@ -69,6 +69,7 @@ std::vector<std::pair<Effect, Location>> CandidateEffects();
 struct AugmentedModel {
   HwModel nominal;
   EffectBlock block;
+  double output_offset = 0.0;  // constant added to the output (sensor or operating-point offset)
 
   // Noise-free output for input u, simulated from rest. Returns false (and fills with a large
   // value) when the recursion diverges, so that an optimiser sees a bad but finite cost.

@@ -26,10 +26,12 @@ Vec LogSpace(double lo, double hi, int n) {
 // Which model numbers the optimiser may move, and how they map to a flat vector.
 struct Packing {
   int na = 0, nb = 0, nin = 0, nout = 0;
+  bool offset = false;
   std::vector<int> effect;  // indices into block.params
 
-  static Packing For(const AugmentedModel& m, bool refit_maps, bool with_effect_smooth) {
+  static Packing For(const AugmentedModel& m, bool refit_maps, bool with_effect_smooth, bool with_offset) {
     Packing p;
+    p.offset = with_offset;
     p.na = static_cast<int>(m.nominal.linear.a.size());
     p.nb = static_cast<int>(m.nominal.linear.b.size());
     if (refit_maps && m.nominal.input.kind == StaticMap::Kind::kPolynomial)
@@ -49,6 +51,7 @@ struct Packing {
     for (int i = 0; i < nin; ++i) v.push_back(m.nominal.input.coefficients[i + 1]);
     for (int i = 0; i < nout; ++i) v.push_back(m.nominal.output.coefficients[i + 1]);
     for (int i : effect) v.push_back(m.block.params[i]);
+    if (offset) v.push_back(m.output_offset);
     return v;
   }
   void Unpack(const Vec& v, AugmentedModel* m) const {
@@ -58,6 +61,7 @@ struct Packing {
     for (int i = 0; i < nin; ++i) m->nominal.input.coefficients[i + 1] = v[k++];
     for (int i = 0; i < nout; ++i) m->nominal.output.coefficients[i + 1] = v[k++];
     for (int i : effect) m->block.params[i] = v[k++];
+    if (offset) m->output_offset = v[k++];
     Legalise(&m->block);
   }
   // Keeps the optimiser inside each block's domain (widths >= 0, lower < upper).
@@ -89,7 +93,7 @@ void Residual(const AugmentedModel& m, const Segment& s, Vec* r) {
 }
 
 // Exact output-error numerator for fixed poles: y ~ sum_j b_j f_{t-d-j}, f = x / A(q).
-bool SolveNumerator(AugmentedModel* m, const Segment& s) {
+bool SolveNumerator(AugmentedModel* m, const Segment& s, bool with_offset) {
   if (m->nominal.output.kind != StaticMap::Kind::kIdentity || m->block.location != Location::kInput) return false;
   Vec x = ApplyInputBlock(m->block, *s.u);
   for (auto& v : x) v = m->nominal.input(v);
@@ -99,18 +103,20 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s) {
   const long d = m->nominal.linear.delay;
   const std::size_t n = s.y->size();
   if (n <= s.skip + nb) return false;
-  Eigen::MatrixXd phi(n - s.skip, nb);
+  Eigen::MatrixXd phi(n - s.skip, nb + (with_offset ? 1 : 0));
   Eigen::VectorXd yy(n - s.skip);
   for (std::size_t t = s.skip; t < n; ++t) {
     for (int j = 0; j < nb; ++j) {
       const long k = static_cast<long>(t) - d - j;
       phi(t - s.skip, j) = k >= 0 ? f[k] : 0.0;
     }
+    if (with_offset) phi(t - s.skip, nb) = 1.0;
     yy(t - s.skip) = (*s.y)[t];
   }
   const Eigen::VectorXd b = phi.colPivHouseholderQr().solve(yy);
   if (!b.allFinite()) return false;
   for (int j = 0; j < nb; ++j) m->nominal.linear.b[j] = b(j);
+  if (with_offset) m->output_offset = b(nb);
   return true;
 }
 
@@ -209,7 +215,7 @@ Vec LocalValues(Effect e, double v) {
 RefitResult Polish(AugmentedModel m, const Segment& s, const RefitOptions& o) {
   // LM on the linear block, maps and smooth effect parameters.
   auto lm = [&](AugmentedModel* mm, bool effect_smooth) {
-    const Packing pk = Packing::For(*mm, o.refit_maps, effect_smooth);
+    const Packing pk = Packing::For(*mm, o.refit_maps, effect_smooth, o.fit_output_offset);
     Vec p0 = pk.Pack(*mm);
     Vec scale(p0.size(), 1e-3);
     for (std::size_t i = 0; i < p0.size(); ++i) scale[i] = std::max(std::abs(p0[i]), 1e-3);
@@ -237,7 +243,7 @@ RefitResult Polish(AugmentedModel m, const Segment& s, const RefitOptions& o) {
         t.block.params[i] = v;
         std::string err;
         if (!t.block.IsValid(&err)) continue;
-        SolveNumerator(&t, s);
+        SolveNumerator(&t, s, o.fit_output_offset);
         const double c = SumSquaredError(t, s);
         if (c < best) best = c, best_v = v;
       }
@@ -481,6 +487,7 @@ HwModel FitNominal(const NominalSpec& spec, const Segment& data) {
                : fmt::format("linear:{},{},{}", spec.na, spec.nb, spec.delay);
   RefitOptions o;
   o.lm.max_iterations = 80;
+  o.fit_output_offset = false;  // HwModel has no offset; the diagnosis estimates one with every refit
   return RefitNominal(m, data, o).model.nominal;
 }
 
@@ -490,7 +497,7 @@ RefitResult RefitNominal(const HwModel& nominal, const Segment& data, const Refi
 }
 
 RefitResult RefitWithEffect(const HwModel& nominal, Effect effect, Location location, const Segment& data,
-                            const RefitOptions& options) {
+                            const RefitOptions& options, double output_offset) {
   if (effect == Effect::kNone) return RefitNominal(nominal, data, options);
   const Vec& u = *data.u;
   Vec zhat = LinearBlock(nominal.linear).simulate([&] {
@@ -501,10 +508,10 @@ RefitResult RefitWithEffect(const HwModel& nominal, Effect effect, Location loca
   const auto grid = EffectGrid(effect, location, u, *data.y, zhat, nominal);
   std::vector<std::pair<double, AugmentedModel>> scored;
   for (const auto& p : grid) {
-    AugmentedModel m{nominal, {effect, location, p}};
+    AugmentedModel m{nominal, {effect, location, p}, options.fit_output_offset ? output_offset : 0.0};
     std::string err;
     if (!m.block.IsValid(&err)) continue;
-    SolveNumerator(&m, data);
+    SolveNumerator(&m, data, options.fit_output_offset);
     const double c = SumSquaredError(m, data);
     if (std::isfinite(c)) scored.emplace_back(c, m);
   }

@@ -60,6 +60,7 @@ HwModel FitNominal(const NominalSpec& spec, const Segment& data);
 
 struct RefitOptions {
   bool refit_maps = true;   // also re-estimate polynomial map coefficients (first coefficient held at its value)
+  bool fit_output_offset = true;  // estimate a constant output offset with every refit (baseline included)
   int keep_grid_points = 3; // grid points refined by LM
   LmOptions lm;
   bool IsValid(std::string* error) const;
@@ -74,8 +75,9 @@ struct RefitResult {
 // Refit of the nominal model with no block (the fair baseline: same optimiser, same data).
 RefitResult RefitNominal(const HwModel& nominal, const Segment& data, const RefitOptions& options);
 // Joint refit of one effect block at one location with the model's parameters.
+// `output_offset` is the starting output offset (e.g. the baseline refit's).
 RefitResult RefitWithEffect(const HwModel& nominal, Effect effect, Location location, const Segment& data,
-                            const RefitOptions& options);
+                            const RefitOptions& options, double output_offset = 0.0);
 
 // Reflects roots of A(q) outside the unit circle inside it (keeps the model simulable).
 std::vector<double> StabilisedDenominator(const std::vector<double>& a);

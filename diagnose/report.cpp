@@ -95,7 +95,11 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
       {"augmented_on_validation",
        {{"whiteness", r.whiteness_augmented.to_json()}, {"input_cross_correlation", r.input_corr_augmented.to_json()}}}};
   j["models"] = {{"nominal", r.nominal_model.to_json()},
-                 {"nominal_refit", r.nominal_refit_model.to_json()},
+                 {"nominal_refit", [&] {
+                    auto m = r.nominal_refit_model.to_json();
+                    m["output_offset"] = r.nominal_refit_offset;
+                    return m;
+                  }()},
                  {"augmented", r.augmented_model.to_json()}};
   j["data"] = {{"identification", {{"name", ident.name}, {"samples", ident.y.size()}}},
                {"validation", {{"name", valid.name}, {"samples", valid.y.size()}}}};
