@@ -12,6 +12,7 @@ void AddBoundsCommand(CLI::App& app);
 void AddDiagnoseCommand(CLI::App& app);
 void AddScenarioCommand(CLI::App& app);
 void AddBrouriCommand(CLI::App& app);
+void AddEsmaeilaniCommand(CLI::App& app);
 // Further commands are declared here as their modules land (bounds, brouri, esmaeilani, diagnose, compare).
 
 }  // namespace hw::cli

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   hw::cli::AddDiagnoseCommand(app);
   hw::cli::AddScenarioCommand(app);
   hw::cli::AddBrouriCommand(app);
+  hw::cli::AddEsmaeilaniCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -52,6 +52,9 @@ int main(int argc, char** argv) {
   if (const char* w = std::getenv("ESM_WS")) opt.weight_state = std::atof(w);
   if (const char* w = std::getenv("ESM_WV")) opt.weight_noise = std::atof(w);
   if (const char* w = std::getenv("ESM_IT")) opt.max_iterations = std::atoi(w);
+  if (const char* w = std::getenv("ESM_WO")) opt.weight_output = std::atof(w);
+  if (const char* w = std::getenv("ESM_GF")) opt.grid_f = std::atoi(w);
+  if (const char* w = std::getenv("ESM_GG")) opt.grid_g = std::atoi(w);
   // The true system in the estimator's normalisation f(0)=0, f(50)=50, g^{-1}(20)=20, g^{-1}(80)=80.
   EsmaeilaniModel truth = valve.TrueModel(41);
   {
@@ -72,16 +75,85 @@ int main(int argc, char** argv) {
   fmt::print("a = [{:.4f}], b = [{:.4f}], d = {:.4f}\n", fmt::join(m.a, ", "), fmt::join(m.b, ", "), m.d);
   fmt::print("f' = [{:.2f}]\n", fmt::join(m.f_values, ", "));
   fmt::print("g^-1' = [{:.2f}] on y' = [{:.1f}]\n", fmt::join(m.ginv_values, ", "), fmt::join(m.y_grid, ", "));
-  nlohmann::json report;
+  nlohmann::json report = {{"case", "valve (simulated rebuild of paper 002 Section 4)"},
+                           {"samples_per_operation", samples},
+                           {"estimation_operations", est.size()},
+                           {"validation_operations", val.size()},
+                           {"order", opt.order},
+                           {"grid_f", opt.grid_f},
+                           {"grid_g", opt.grid_g},
+                           {"weights", {opt.weight_state, opt.weight_output, opt.weight_noise}},
+                           {"status", sum.message},
+                           {"iterations", sum.iterations},
+                           {"unknowns", sum.unknowns},
+                           {"seconds", sum.seconds},
+                           {"qp_seconds", sum.qp_seconds},
+                           {"final_cost", sum.final_cost},
+                           {"estimate", m.ToJson()},
+                           {"truth_normalised", truth.ToJson()}};
   std::string md = "# Esmaeilani valve case (simulated rebuild of paper 002, Section 4)\n\n";
-  md += "| operation | fit % = 100(1-‖y-ŷ‖/‖y-ȳ‖) | max error (% of range) | fit vs noise-free % |\n|---|---|---|---|\n";
+  md += fmt::format("Nine closing operations for estimation, three for validation, {} samples each; order {}, "
+                    "{} + {} ordered pairs, weights (state, output, noise) = ({}, {}, {}).\n\n",
+                    samples, opt.order, opt.grid_f, opt.grid_g, opt.weight_state, opt.weight_output,
+                    opt.weight_noise);
+  md += fmt::format("Solver: {} after {} SQP iterations, {:.2f} s ({:.2f} s in Ipopt QPs), {} unknowns.\n\n",
+                    sum.message, sum.iterations, sum.seconds, sum.qp_seconds, sum.unknowns);
+  md += fmt::format("Estimated a = [{:.4f}], b = [{:.4f}] (paper order; truth in this normalisation: a = [{:.4f}], "
+                    "b = [{:.4f}])\n\n", fmt::join(m.a, ", "), fmt::join(m.b, ", "), fmt::join(truth.a, ", "),
+                    fmt::join(truth.b, ", "));
+  md += "| operation | fit % = 100(1-‖y-ŷ‖/‖y-ȳ‖) | max error (% of range 0-100) | fit vs noise-free % |\n|---|---|---|---|\n";
+  CsvTable traces;
   for (std::size_t k = 0; k < val.size(); ++k) {
     const auto yh = m.Simulate(val[k].u);
     const double fit = fit_percent(val[k].y, yh), fitw = fit_percent(val_w[k], yh);
     const double maxe = MaxAbsError(val[k].y, yh);
     fmt::print("validation {}: fit {:.2f} %, max error {:.2f} %, fit vs noise-free {:.2f} %\n", k + 1, fit, maxe, fitw);
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} |\n", k + 1, fit, maxe, fitw);
+    report["validation"].push_back({{"fit_percent", fit}, {"max_error_percent_of_range", maxe}, {"fit_noise_free", fitw}});
+    traces.add_column(fmt::format("u{}", k + 1), val[k].u);
+    traces.add_column(fmt::format("y{}", k + 1), val[k].y);
+    traces.add_column(fmt::format("yhat{}", k + 1), yh);
   }
+  write_csv(out + "/validation.csv", traces);
+  CsvTable fcurve, gcurve;
+  std::vector<double> uu, ft, fe, yy, gt, ge;
+  for (int i = 0; i <= 200; ++i) {
+    const double u = 0.5 * i;
+    uu.push_back(u), ft.push_back(truth.F(u)), fe.push_back(m.F(u));
+    const double y = m.y_grid.front() + (m.y_grid.back() - m.y_grid.front()) * i / 200.0;
+    yy.push_back(y), gt.push_back(truth.Ginv(y)), ge.push_back(m.Ginv(y) - m.output_offset + truth.output_offset);
+  }
+  fcurve.add_column("u", uu), fcurve.add_column("f_true", ft), fcurve.add_column("f_est", fe);
+  gcurve.add_column("y", yy), gcurve.add_column("ginv_true", gt), gcurve.add_column("ginv_est", ge);
+  write_csv(out + "/f_curve.csv", fcurve);
+  write_csv(out + "/ginv_curve.csv", gcurve);
+  const std::string gp = R"(set terminal pngcairo size 1200,450
+set datafile separator ','
+set key autotitle columnhead
+set output 'functions.png'
+set multiplot layout 1,2
+set title 'Hammerstein function f (normalised f(0)=0, f(50)=50)'
+set xlabel 'command u (%)'
+plot 'f_curve.csv' u 1:2 w l lw 2 t 'true', '' u 1:3 w l lw 2 dt 2 t 'estimated'
+set title 'inverse Wiener function g^{-1} (normalised g^{-1}(20)=20, g^{-1}(80)=80)'
+set xlabel 'valve position y (%)'
+plot 'ginv_curve.csv' u 1:2 w l lw 2 t 'true', '' u 1:3 w l lw 2 dt 2 t 'estimated (offset m_e aligned)'
+unset multiplot
+set output 'validation.png'
+set multiplot layout 1,3
+set xlabel 'sample'
+set yrange [-5:105]
+do for [k=1:3] {
+  set title sprintf('validation operation %d', k)
+  plot 'validation.csv' u 0:(column(3*k-2)) w l t 'command u', '' u 0:(column(3*k-1)) w l t 'measured y', '' u 0:(column(3*k)) w l dt 2 lw 2 t 'simulated'
+}
+unset multiplot
+)";
+  write_text_atomic(out + "/plots.gp", gp);
+  md += "\n![functions](functions.png)\n\n![validation](validation.png)\n";
   write_text_atomic(out + "/report.md", md);
+  write_text_atomic(out + "/report.json", report.dump(2) + "\n");
+  const int rc = std::system(fmt::format("cd '{}' && gnuplot plots.gp", out).c_str());
+  if (rc != 0) fmt::print(stderr, "gnuplot failed (exit {}); data and script are in {}\n", rc, out);
   return 0;
 }

@@ -32,7 +32,7 @@ Segment ValveCase::ClosingOperation(unsigned seed, int samples, std::vector<doub
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::normal_distribution<double> N(0.0, 1.0);
   const int hold = 5 + static_cast<int>(10 * U(rng));
-  const double level1 = 40 + 40 * U(rng), level2 = 5 + 45 * U(rng);
+  const double level1 = 40 + 40 * U(rng), level2 = 2 + 28 * U(rng);  // closing ends nearly closed
   const int switch_at = hold + samples / 3 + static_cast<int>(samples / 4 * U(rng));
   const double tau1 = 3 + 8 * U(rng), tau2 = 3 + 8 * U(rng);
   std::vector<double> cmd(samples);
