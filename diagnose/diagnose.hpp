@@ -41,7 +41,7 @@ struct DiagnoseOptions {
   double noise_std = 0.0;             // 0 = estimate from the nominal residual
   std::size_t init_samples = 0;       // leading samples excluded from every cost (transient from rest)
   double holdout_fraction = 1.0 / 3;  // tail of the identification recording used for ranking
-  double significance_z = 1.5;        // held-out paired test threshold (a pre-screen; validation decides)
+  double significance_z = 1.0;        // held-out paired test threshold (a pre-screen; validation decides)
   double min_improvement = 0.05;      // minimum penalised held-out MSE reduction (fraction)
   double validation_z = 2.0;          // the verdict must also beat the nominal on validation
   int max_validated = 3;              // significant candidates tried on validation, in rank order
