@@ -1,7 +1,7 @@
 // Reproduction of paper 002 (Esmaeilani et al., IET CTA 2020), Section 4: the pressure-control valve,
 // rebuilt in simulation (the plant recordings are private). Twelve closing operations: nine for
 // estimation, three for validation. Writes Markdown + JSON + CSV + gnuplot PNGs to the output dir.
-//   esmaeilani_valve [out_dir] [samples_per_operation]
+//   esmaeilani_valve [out_dir] [samples_per_operation] [w_state w_output w_noise] [max_iterations]
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -49,12 +49,11 @@ int main(int argc, char** argv) {
   opt.order = 3;
   opt.grid_f = 12;
   opt.grid_g = 12;
-  if (const char* w = std::getenv("ESM_WS")) opt.weight_state = std::atof(w);
-  if (const char* w = std::getenv("ESM_WV")) opt.weight_noise = std::atof(w);
-  if (const char* w = std::getenv("ESM_IT")) opt.max_iterations = std::atoi(w);
-  if (const char* w = std::getenv("ESM_WO")) opt.weight_output = std::atof(w);
-  if (const char* w = std::getenv("ESM_GF")) opt.grid_f = std::atoi(w);
-  if (const char* w = std::getenv("ESM_GG")) opt.grid_g = std::atoi(w);
+  // Residual weights (state, output, noise): the paper's are 1, 1, 1.
+  if (argc > 3) opt.weight_state = std::atof(argv[3]);
+  if (argc > 4) opt.weight_output = std::atof(argv[4]);
+  if (argc > 5) opt.weight_noise = std::atof(argv[5]);
+  if (argc > 6) opt.max_iterations = std::atoi(argv[6]);
   // The true system in the estimator's normalisation f(0)=0, f(50)=50, g^{-1}(20)=20, g^{-1}(80)=80.
   EsmaeilaniModel truth = valve.TrueModel(41);
   {
@@ -63,8 +62,17 @@ int main(int argc, char** argv) {
     for (auto& v : truth.b) v *= c;
     truth.output_offset = o;
   }
-  if (std::getenv("ESM_TRUTH")) opt.initial = &truth;
+  if (std::getenv("ESM_START_AT_TRUTH")) opt.initial = &truth;  // diagnostic: warm start at the truth
   const Constraints cons = valve.KnownInformation();
+  // The same data and known information as files, for `hwbounds esmaeilani` (see docs/esmaeilani.md).
+  for (std::size_t k = 0; k < 12; ++k) {
+    const Segment& s = k < 9 ? est[k] : val[k - 9];
+    CsvTable t;
+    t.add_column("u", s.u);
+    t.add_column("y", s.y);
+    write_csv(fmt::format("{}/{}{}.csv", out, k < 9 ? "est" : "val", k < 9 ? k + 1 : k - 8), t);
+  }
+  write_text_atomic(out + "/valve_constraints.json", cons.ToJson().dump(2) + "\n");
   Summary sum;
   const EsmaeilaniModel m = Estimate(opt, est, cons, &sum);
   fmt::print("{}: {} iterations, cost {:.4g} -> {:.4g}, {:.2f} s (QP {:.2f} s, {} Ipopt iterations), {} unknowns\n",
@@ -121,7 +129,7 @@ int main(int argc, char** argv) {
     const double u = 0.5 * i;
     uu.push_back(u), ft.push_back(truth.F(u)), fe.push_back(m.F(u));
     const double y = m.y_grid.front() + (m.y_grid.back() - m.y_grid.front()) * i / 200.0;
-    yy.push_back(y), gt.push_back(truth.Ginv(y)), ge.push_back(m.Ginv(y) - m.output_offset + truth.output_offset);
+    yy.push_back(y), gt.push_back(truth.Ginv(y)), ge.push_back(m.Ginv(y));
   }
   fcurve.add_column("u", uu), fcurve.add_column("f_true", ft), fcurve.add_column("f_est", fe);
   gcurve.add_column("y", yy), gcurve.add_column("ginv_true", gt), gcurve.add_column("ginv_est", ge);
@@ -137,7 +145,7 @@ set xlabel 'command u (%)'
 plot 'f_curve.csv' u 1:2 w l lw 2 t 'true', '' u 1:3 w l lw 2 dt 2 t 'estimated'
 set title 'inverse Wiener function g^{-1} (normalised g^{-1}(20)=20, g^{-1}(80)=80)'
 set xlabel 'valve position y (%)'
-plot 'ginv_curve.csv' u 1:2 w l lw 2 t 'true', '' u 1:3 w l lw 2 dt 2 t 'estimated (offset m_e aligned)'
+plot 'ginv_curve.csv' u 1:2 w l lw 2 t 'true', '' u 1:3 w l lw 2 dt 2 t 'estimated'
 unset multiplot
 set output 'validation.png'
 set multiplot layout 1,3

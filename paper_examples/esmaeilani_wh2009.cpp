@@ -4,7 +4,7 @@
 // too slow for the SQP, so estimation uses `segments` windows of `length` samples spread over the
 // estimation part (each window has its own initial state). Test: samples 100001..188000, simulation
 // RMSE in mV, simulated from the steady state at the first test input.
-//   esmaeilani_wh2009 [out_dir] [segments] [length] [order] [grid]
+//   esmaeilani_wh2009 [out_dir] [segments] [length] [order] [grid] [data_csv] [max_iterations]
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -72,6 +72,7 @@ int main(int argc, char** argv) {
     std::string line;
     std::getline(in, line);
     for (int ln = 2; std::getline(in, line); ++ln) {
+      if (line.find_first_not_of(" \r\t,") == std::string::npos) continue;  // blank trailing line
       std::stringstream ss(line);
       std::string a, b;
       std::getline(ss, a, ',');
@@ -99,7 +100,7 @@ int main(int argc, char** argv) {
   opt.order = order;
   opt.grid_f = grid;
   opt.grid_g = grid;
-  if (const char* w = std::getenv("ESM_IT")) opt.max_iterations = std::atoi(w);
+  opt.max_iterations = argc > 7 ? std::atoi(argv[7]) : 40;
   // Normalisation only (the circuit's nonlinearity is unknown): f and g^{-1} pass through two points of
   // the identity, both nondecreasing.
   Constraints c;
