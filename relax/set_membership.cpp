@@ -226,7 +226,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   std::mutex mu;
   std::vector<double> solve_times;
   std::vector<std::string> orthant_status(L, "undecided");
-  std::vector<std::set<int>> working(L);
+  std::map<std::pair<int, int>, std::set<int>> working;  // (orthant, order) -> data constraints in use
   std::vector<std::vector<Polynomial>> candidates(L);
   std::vector<std::once_flag> built(L);
   auto candidates_of = [&](int l) -> const std::vector<Polynomial>& {
@@ -296,7 +296,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
       auto out = JobOutcome::from_json(*j);
       std::lock_guard<std::mutex> lock(mu);
       ++summary.jobs_from_cache;
-      working[l].insert(out.working_set.begin(), out.working_set.end());
+      working[{l, d}].insert(out.working_set.begin(), out.working_set.end());
       return out;
     }
     {
@@ -312,7 +312,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     std::vector<int> initial;
     {
       std::lock_guard<std::mutex> lock(mu);
-      initial.assign(working[l].begin(), working[l].end());
+      const auto& ws = working[{l, d}];
+      initial.assign(ws.begin(), ws.end());
     }
     ConstraintGenerationOptions gen = opts.generation;
     gen.order = d;
@@ -320,7 +321,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     const auto r = SolveWithConstraintGeneration(gen, core, candidates_of(l), initial, *solver,
                                                  [&](const std::vector<int>& ws) {
                                                    std::lock_guard<std::mutex> lock(mu);
-                                                   working[l].insert(ws.begin(), ws.end());
+                                                   working[{l, d}].insert(ws.begin(), ws.end());
                                                  });
     JobOutcome out;
     out.rounds = r.rounds;
@@ -353,7 +354,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   };
 
   // 2. Cheap pass at the minimal order (also the final pass when order == minimal).
-  const int cheap_order = options.cheap_pass ? min_order : options.order;
+  // The cheap pass needs informative bounds to skip anything: order 1 (Shor) returns the box edges for these
+  // problems, so the cheap order is at least 2; with nothing cheaper than the target order, no cheap pass.
+  const int cheap_order = options.cheap_pass ? std::min(options.order, std::max(min_order, 2)) : options.order;
   std::map<std::pair<int, int>, JobOutcome> cheap;  // (orthant, objective)
   {
     std::vector<std::pair<int, int>> jobs;

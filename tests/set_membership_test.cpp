@@ -19,7 +19,7 @@ HwStructure PaperStructure() {
   return s;
 }
 
-BoundsSummary Run(uint64_t seed, int samples, int horizon, int order, double snr_db, const std::string& solver = "sdpa",
+BoundsSummary RunBounds(uint64_t seed, int samples, int horizon, int order, double snr_db, const std::string& solver = "sdpa",
                   double box = 10.0) {
   const auto ex = SimulateCeroneExample(seed, samples, snr_db);
   HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
@@ -46,18 +46,18 @@ void ExpectCoverage(const BoundsSummary& s, const std::string& label) {
 
 TEST(SetMembership, CoversTruthOnTwentySeededInstancesHorizon1) {
   for (uint64_t seed = 1; seed <= 20; ++seed) {
-    const auto s = Run(seed, 40, 1, 1, 31.0);
+    const auto s = RunBounds(seed, 40, 1, 1, 31.0);
     ExpectCoverage(s, "seed " + std::to_string(seed));
   }
 }
 
 TEST(SetMembership, CoversTruthHorizon2Order2) {
-  for (uint64_t seed : {101u, 102u, 103u}) ExpectCoverage(Run(seed, 30, 2, 2, 31.0), "n=2 seed " + std::to_string(seed));
+  for (uint64_t seed : {101u, 102u, 103u}) ExpectCoverage(RunBounds(seed, 30, 2, 2, 31.0), "n=2 seed " + std::to_string(seed));
 }
 
 TEST(SetMembership, TinyNoiseShrinksIntervalsAroundTruth) {
-  const auto noisy = Run(5, 40, 1, 2, 31.0);
-  const auto clean = Run(5, 40, 1, 2, 80.0);
+  const auto noisy = RunBounds(5, 40, 1, 2, 31.0);
+  const auto clean = RunBounds(5, 40, 1, 2, 80.0);
   ExpectCoverage(clean, "80 dB");
   double wn = 0, wc = 0;
   for (std::size_t k = 0; k < noisy.intervals.size(); ++k) {
@@ -68,8 +68,8 @@ TEST(SetMembership, TinyNoiseShrinksIntervalsAroundTruth) {
 }
 
 TEST(SetMembership, CsdpAndSdpaGiveTheSameIntervals) {
-  const auto a = Run(9, 30, 1, 1, 31.0, "csdp");
-  const auto b = Run(9, 30, 1, 1, 31.0, "sdpa");
+  const auto a = RunBounds(9, 30, 1, 1, 31.0, "csdp");
+  const auto b = RunBounds(9, 30, 1, 1, 31.0, "sdpa");
   for (std::size_t k = 0; k < a.intervals.size(); ++k) {
     EXPECT_NEAR(a.intervals[k].lower.value, b.intervals[k].lower.value, 1e-4);
     EXPECT_NEAR(a.intervals[k].upper.value, b.intervals[k].upper.value, 1e-4);
