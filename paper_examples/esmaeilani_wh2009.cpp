@@ -113,8 +113,8 @@ int main(int argc, char** argv) {
   const auto yh = m.Simulate(u_test);
   const auto yl = LinearArx(segs, order, u_test);
   const double rmse_hw = 1000 * rmse(y_test, yh), rmse_lin = 1000 * rmse(y_test, yl);
-  fmt::print("{}; {} iterations, {:.1f} s (QP {:.1f} s), {} unknowns\n", sum.message, sum.iterations, sum.seconds,
-             sum.qp_seconds, sum.unknowns);
+  fmt::print("{}; {} iterations, {:.1f} s (QP {:.1f} s, Jacobian and QP set-up {:.1f} s), {} unknowns\n", sum.message,
+             sum.iterations, sum.seconds, sum.qp_seconds, sum.setup_seconds, sum.unknowns);
   fmt::print("test RMSE: esmaeilani HW {:.2f} mV (fit {:.2f} %), linear ARX({},{}) {:.2f} mV\n", rmse_hw,
              fit_percent(y_test, yh), order, order, rmse_lin);
   std::string md = "# Esmaeilani estimator on the Wiener–Hammerstein benchmark 2009\n\n";

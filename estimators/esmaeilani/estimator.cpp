@@ -549,10 +549,13 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
   for (iter = 0; iter < options.max_iterations; ++iter) {
     // Iteration 0 holds (a, b, d): the problem is then linear in the rest and one QP solves it exactly.
     const bool hold_linear = iter == 0;
+    const auto setup_start = Clock::now();
     Eigen::VectorXd r;
     Eigen::SparseMatrix<double> J;
     P.Evaluate(al, &r, &J);
-    Eigen::SparseMatrix<double> JtJ = (J.transpose() * J).pruned();
+    // Jt * J with an explicit transpose: (J^T * J).pruned() took 50x longer (0.5 s at 12k unknowns).
+    const Eigen::SparseMatrix<double> Jt = J.transpose();
+    Eigen::SparseMatrix<double> JtJ = Jt * J;
     Eigen::VectorXd diag = JtJ.diagonal();
     Eigen::SparseMatrix<double> reg(L.size(), L.size());
     std::vector<Eigen::Triplet<double>> rt;
@@ -575,6 +578,7 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
     if (!options.estimate_output_offset) qp.var_lower[L.offset()] = qp.var_upper[L.offset()] = -al[L.offset()];
     Eigen::VectorXd step = Eigen::VectorXd::Zero(L.size());
     const auto qp_start = Clock::now();
+    sum.setup_seconds += std::chrono::duration<double>(qp_start - setup_start).count();
     const QpSummary qs = SolveQp(options.qp, qp, &step);
     sum.qp_seconds += std::chrono::duration<double>(Clock::now() - qp_start).count();
     sum.qp_iterations += qs.iterations;

@@ -119,6 +119,7 @@ struct Summary {
   std::vector<double> cost_history;
   std::vector<double> step_lengths;  // accepted fraction of each Gauss-Newton step
   double seconds = 0.0, qp_seconds = 0.0;
+  double setup_seconds = 0.0;  // residual, Jacobian, J^T J and QP data per iteration
   int qp_iterations = 0;
   bool ok() const { return status != Status::kFailed; }
 };
