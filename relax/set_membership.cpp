@@ -202,6 +202,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
 
   // Problem hash for the run directory: everything that changes the numbers.
   nlohmann::json meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
+                         {"cheap_pass", options.cheap_pass},
                          {"solver", options.solver}, {"box", set.box()},
                          {"violation_tolerance", options.generation.violation_tolerance},
                          {"gap_tolerance", options.generation.sdp.gap_tolerance}};
@@ -281,8 +282,19 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   }
 
   // Objectives: min and max of every parameter.
+  std::vector<int> wanted;
+  for (int k = 0; k < n; ++k)
+    if (options.parameters.empty() ||
+        std::find(options.parameters.begin(), options.parameters.end(), set.layout().names[k]) != options.parameters.end())
+      wanted.push_back(k);
+  for (const auto& name : options.parameters)
+    if (std::find(set.layout().names.begin(), set.layout().names.end(), name) == set.layout().names.end()) {
+      std::string all;
+      for (const auto& nm : set.layout().names) all += (all.empty() ? "" : ", ") + nm;
+      throw InputError(fmt::format("no parameter '{}'; the parameters are: {}", name, all));
+    }
   std::vector<Objective> objectives;
-  for (int k = 0; k < n; ++k) {
+  for (int k : wanted) {
     objectives.push_back({k, -1});
     objectives.push_back({k, +1});
   }
@@ -433,11 +445,12 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   }
 
   // 4. Aggregate (eqs. 31-33) with fallbacks.
-  for (int k = 0; k < n; ++k) {
+  for (std::size_t w = 0; w < wanted.size(); ++w) {
+    const int k = wanted[w];
     ParameterInterval iv;
     iv.name = set.layout().names[k];
     for (int dir : {-1, +1}) {
-      const int o = 2 * k + (dir > 0 ? 1 : 0);
+      const int o = 2 * static_cast<int>(w) + (dir > 0 ? 1 : 0);
       Endpoint ep;
       ep.status = "empty";
       bool any = false;

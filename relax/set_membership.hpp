@@ -31,6 +31,7 @@ struct BoundsOptions {
   std::string solver = "sdpa";
   int threads = 0;               // 0 = all cores
   std::string run_dir;           // resumable cache; empty = none
+  std::vector<std::string> parameters;  // intervals to compute (names); empty = every parameter
   ConstraintGenerationOptions generation;  // its order is set per pass
   bool IsValid(std::string* error) const;
 };
