@@ -31,9 +31,7 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats);
   CLI11_PARSE(app, argc, argv);
   const auto ex = hw::SimulateCeroneExample(1, samples);
-  hw::relax::HwStructure s;
-  s.input_basis = hw::relax::parse_basis("poly:3");
-  s.output_basis = hw::relax::parse_basis("poly:3");
+  const hw::relax::HwStructure s = hw::relax::CeroneExampleStructure();
   hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
   hw::relax::HwOuterSet set(s, data, horizon, std::vector<std::pair<double, double>>(8, {-10, 10}));
   const int l = set.orthant_of(hw::CeroneExample::TrueParameters());

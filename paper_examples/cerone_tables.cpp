@@ -58,12 +58,7 @@ int main(int argc, char** argv) {
   const auto truth = hw::CeroneExample::TrueParameters();
   fmt::print("Example of paper 001, Section VI: N = {}, seed {}, noise bound {:.6g} (realised SNR_w {:.2f} dB)\n",
              samples, seed, ex.noise_bound, ex.snr_db);
-  hw::relax::HwStructure structure;
-  structure.input_basis = hw::relax::parse_basis("poly:3");
-  structure.output_basis = hw::relax::parse_basis("poly:3");
-  structure.na = 2;
-  structure.nb = 2;
-  structure.strictly_proper = true;
+  const hw::relax::HwStructure structure = hw::relax::CeroneExampleStructure();
   hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "cerone2011 example"};
 
   nlohmann::json report;

@@ -39,6 +39,16 @@ bool HwData::IsValid(std::string* error) const {
   return true;
 }
 
+HwStructure CeroneExampleStructure() {
+  HwStructure s;
+  s.input_basis = parse_basis("poly:3");
+  s.output_basis = parse_basis("poly:3");
+  s.na = 2;
+  s.nb = 2;
+  s.strictly_proper = true;
+  return s;
+}
+
 ParameterLayout MakeLayout(const HwStructure& s) {
   ParameterLayout L;
   L.gamma_begin = 0;

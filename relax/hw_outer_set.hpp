@@ -40,6 +40,9 @@ struct HwData {
   bool IsValid(std::string* error) const;
 };
 
+// The model class of paper 001's example: psi = phi = (w, w^2, w^3), na = nb = 2, strictly proper.
+HwStructure CeroneExampleStructure();
+
 // Parameter layout: [gamma_2.., alpha_2.., a_1..a_na, b_j0..b_nb].
 struct ParameterLayout {
   std::vector<std::string> names;

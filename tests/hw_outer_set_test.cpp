@@ -9,16 +9,6 @@
 namespace hw::relax {
 namespace {
 
-HwStructure PaperStructure() {
-  HwStructure s;
-  s.input_basis = parse_basis("poly:3");
-  s.output_basis = parse_basis("poly:3");
-  s.na = 2;
-  s.nb = 2;
-  s.strictly_proper = true;
-  return s;
-}
-
 HwData FromExample(const CeroneExample& ex) {
   return {ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "example"};
 }
@@ -35,7 +25,7 @@ TEST(HwOuterSet, TrueParametersSatisfyEveryInequality) {
   for (int horizon = 1; horizon <= 3; ++horizon) {
     for (uint64_t seed : {1u, 2u, 3u}) {
       auto ex = SimulateCeroneExample(seed, 200);
-      HwOuterSet set(PaperStructure(), FromExample(ex), horizon, Box(8));
+      HwOuterSet set(CeroneExampleStructure(), FromExample(ex), horizon, Box(8));
       const auto p = CeroneExample::TrueParameters();
       EXPECT_GE(set.min_slack(p), -1e-9) << "horizon " << horizon << " seed " << seed;
       // Scaled constraints of the true orthant hold at the scaled true point too.
@@ -50,7 +40,7 @@ TEST(HwOuterSet, TrueParametersSatisfyEveryInequality) {
 
 TEST(HwOuterSet, SignVectorSizeAndDegrees) {
   auto ex = SimulateCeroneExample(1, 100);
-  HwOuterSet set(PaperStructure(), FromExample(ex), 3, Box(8));
+  HwOuterSet set(CeroneExampleStructure(), FromExample(ex), 3, Box(8));
   EXPECT_EQ(set.sign_polynomials().size(), 2u + 3u * 2u);  // alpha2, alpha3, Q_{s,h}
   EXPECT_EQ(set.num_orthants(), 256);
   int max_deg = 0;
@@ -64,7 +54,7 @@ TEST(HwOuterSet, SignVectorSizeAndDegrees) {
 
 TEST(HwOuterSet, BadInputIsRejectedClearly) {
   HwData d{{1, 2, 3}, {1, 2, 3}, {0.1, 0.1, 0.1}, "rec.csv"};
-  EXPECT_THROW(HwOuterSet(PaperStructure(), d, 2, Box(8)), InputError);  // too short
+  EXPECT_THROW(HwOuterSet(CeroneExampleStructure(), d, 2, Box(8)), InputError);  // too short
   HwData bad{{1, 2}, {1, 2}, {0.1, -1}, "rec.csv"};
   std::string err;
   EXPECT_FALSE(bad.IsValid(&err));

@@ -12,21 +12,12 @@
 namespace hw::relax {
 namespace {
 
-HwStructure PaperStructure() {
-  HwStructure s;
-  s.input_basis = parse_basis("poly:3");
-  s.output_basis = parse_basis("poly:3");
-  s.na = 2;
-  s.nb = 2;
-  return s;
-}
-
 BoundsSummary RunBounds(uint64_t seed, int samples, int horizon, int order, double snr_db, const std::string& solver = "sdpa",
                   std::vector<std::string> params = {}) {
   const double box = 10.0;
   const auto ex = SimulateCeroneExample(seed, samples, snr_db);
   HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  HwOuterSet set(PaperStructure(), data, horizon, std::vector<std::pair<double, double>>(8, {-box, box}));
+  HwOuterSet set(CeroneExampleStructure(), data, horizon, std::vector<std::pair<double, double>>(8, {-box, box}));
   BoundsOptions options;
   options.order = order;
   options.solver = solver;
