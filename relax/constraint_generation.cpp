@@ -24,7 +24,8 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
                                                          const PolyProblem& core,
                                                          const std::vector<Polynomial>& candidates,
                                                          std::vector<int> initial, sdp::SdpSolver& solver,
-                                                         const std::function<void(const std::vector<int>&)>& on_round) {
+                                                         const std::function<void(const std::vector<int>&)>& on_round,
+                                                         sdp::SdpSolver* fallback) {
   ConstraintGenerationResult result;
   std::string error;
   if (!options.IsValid(&error) || !core.IsValid(&error)) {
@@ -45,7 +46,14 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     MomentRelaxation relaxation(problem, order);
     result.num_moments = relaxation.lmi().c.size();
     result.num_blocks = relaxation.lmi().blocks.size();
-    const auto sdp = solver.Solve(options.sdp, relaxation.lmi());
+    auto sdp = solver.Solve(options.sdp, relaxation.lmi());
+    if (fallback && sdp.status != sdp::SdpStatus::kOptimal && sdp.status != sdp::SdpStatus::kInfeasible &&
+        sdp.status != sdp::SdpStatus::kUnbounded) {
+      const std::string first = sdp.message;
+      result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
+      sdp = fallback->Solve(options.sdp, relaxation.lmi());
+      sdp.message += " [after " + first + "]";
+    }
     result.last_sdp = sdp;
     result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
     result.sdp_iterations += sdp.iterations;

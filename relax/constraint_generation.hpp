@@ -40,11 +40,13 @@ struct ConstraintGenerationResult {
 };
 
 // `core` inequalities are always in the LMI; `candidates` enter on demand, starting from `initial`.
-// `on_round` (optional) sees the working set after each round (for resumable runs).
+// `on_round` (optional) sees the working set after each round (for resumable runs). When the solver fails on
+// a round's LMI (neither optimal nor a certified infeasible/unbounded outcome), `fallback` (optional, e.g. the
+// other backend) solves the same LMI before the round is declared failed.
 ConstraintGenerationResult SolveWithConstraintGeneration(
     const ConstraintGenerationOptions& options, const PolyProblem& core, const std::vector<Polynomial>& candidates,
     std::vector<int> initial, sdp::SdpSolver& solver,
-    const std::function<void(const std::vector<int>&)>& on_round = {});
+    const std::function<void(const std::vector<int>&)>& on_round = {}, sdp::SdpSolver* fallback = nullptr);
 
 // LP screen of a semialgebraic set { g_i(x) >= 0 } inside [-1, 1]^n: each monomial of degree <= D becomes a
 // free variable with |y_alpha| <= 1 and y_alpha >= 0 for even alpha; infeasibility of this LP proves the set

@@ -186,6 +186,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   // multiplier X >= 0 with sum_i |F_i . X| < F_0 . X already proves emptiness; 0.5 leaves a margin.
   BoundsOptions opts = options;
   opts.generation.sdp.infeasibility_tolerance = std::max(opts.generation.sdp.infeasibility_tolerance, 0.5);
+  // Endpoints come from the dual side, whose validity needs dual feasibility, not a small gap: accept
+  // near-optimal stops up to 1e-5 (the gap costs at most that much tightness on the scaled parameters).
+  opts.generation.sdp.acceptable_gap = std::max(opts.generation.sdp.acceptable_gap, 1e-5);
   const auto t0 = Clock::now();
   const int n = set.num_vars();
   const int L = set.num_orthants();
@@ -330,11 +333,14 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     ConstraintGenerationOptions gen = opts.generation;
     gen.order = d;
     auto solver = sdp::MakeSolver(options.solver);
-    const auto r = SolveWithConstraintGeneration(gen, core, candidates_of(l), initial, *solver,
-                                                 [&](const std::vector<int>& ws) {
-                                                   std::lock_guard<std::mutex> lock(mu);
-                                                   working[{l, d}].insert(ws.begin(), ws.end());
-                                                 });
+    auto other = sdp::MakeSolver(options.solver == "csdp" ? "sdpa" : "csdp");
+    const auto r = SolveWithConstraintGeneration(
+        gen, core, candidates_of(l), initial, *solver,
+        [&](const std::vector<int>& ws) {
+          std::lock_guard<std::mutex> lock(mu);
+          working[{l, d}].insert(ws.begin(), ws.end());
+        },
+        options.retry_with_other_solver ? other.get() : nullptr);
     JobOutcome out;
     out.rounds = r.rounds;
     out.sdp_iterations = r.sdp_iterations;

@@ -29,6 +29,7 @@ struct BoundsOptions {
   bool cheap_pass = true;        // solve the minimal order first to skip objectives (recommended)
   bool lp_screen = true;
   std::string solver = "sdpa";
+  bool retry_with_other_solver = true;  // a failed solve is repeated with the other backend before falling back
   int threads = 0;               // 0 = all cores
   std::string run_dir;           // resumable cache; empty = none
   std::vector<std::string> parameters;  // intervals to compute (names); empty = every parameter
