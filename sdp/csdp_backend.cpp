@@ -282,13 +282,7 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
 }  // namespace
 
 SdpSummary CsdpSolver::Solve(const SdpOptions& options, const LmiProblem& problem) {
-  SdpSummary out = SolveCanonical(options, problem, [&](const LmiProblem& p) { return SolveWithCsdp(options, p); });
-  out.solver = name();
-  if (!options.keep_dual_matrix) {
-    out.X.clear();
-    out.Z.clear();
-  }
-  return out;
+  return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) { return SolveWithCsdp(options, p); });
 }
 
 }  // namespace hw::sdp

@@ -192,6 +192,17 @@ SdpSummary DecideConstantLmi(const LmiProblem& p) {
 
 }  // namespace
 
+SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, const LmiProblem& problem,
+                          const std::function<SdpSummary(const LmiProblem&)>& solve) {
+  SdpSummary out = SolveCanonical(options, problem, solve);
+  out.solver = name;
+  if (!options.keep_dual_matrix) {
+    out.X.clear();
+    out.Z.clear();
+  }
+  return out;
+}
+
 SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
                           const std::function<SdpSummary(const LmiProblem&)>& solve) {
   std::string error;

@@ -99,6 +99,9 @@ void AcceptNearOptimal(const SdpOptions& options, SdpSummary* summary);
 // decided directly: F(y) = -F_0 >= 0 or not (an eigenvector of -F_0 certifies infeasibility).
 SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
                           const std::function<SdpSummary(const LmiProblem&)>& solve);
+// SolveCanonical, then the steps every backend shares: name the solver and drop X, Z unless kept.
+SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, const LmiProblem& problem,
+                          const std::function<SdpSummary(const LmiProblem&)>& solve);
 // Relative duality gap as both backends report it: |p - d| / max(1, (|p| + |d|) / 2).
 double RelativeGap(double primal, double dual);
 

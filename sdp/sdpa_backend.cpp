@@ -157,13 +157,7 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
 }  // namespace
 
 SdpSummary SdpaSolver::Solve(const SdpOptions& options, const LmiProblem& problem) {
-  SdpSummary out = SolveCanonical(options, problem, [&](const LmiProblem& p) { return SolveWithSdpa(options, p); });
-  out.solver = name();
-  if (!options.keep_dual_matrix) {
-    out.X.clear();
-    out.Z.clear();
-  }
-  return out;
+  return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) { return SolveWithSdpa(options, p); });
 }
 
 }  // namespace hw::sdp
