@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <fmt/format.h>
@@ -17,6 +18,7 @@ bool ConstraintGenerationOptions::IsValid(std::string* error) const {
   if (max_rounds < 1) return fail("max_rounds must be >= 1");
   if (add_per_round < 1) return fail("add_per_round must be >= 1");
   if (!(violation_tolerance > 0)) return fail("violation_tolerance must be > 0");
+  if (!verify.IsValid(error)) return false;
   return sdp.IsValid(error);
 }
 
@@ -39,6 +41,25 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     for (const auto& g : candidates) all.inequalities.push_back(g);
     order = std::max(order == 0 ? all.minimal_order() : order, all.minimal_order());
   }
+  const bool verify = options.verify.enabled;
+  sdp::SdpOptions sdp_options = options.sdp;
+  if (verify) sdp_options.keep_dual_matrix = true;
+  // Verifies the bound of the final round (a perturbed re-solve may be needed; intermediate rounds' bounds
+  // are never reported, so they are not verified).
+  auto verify_bound = [&](const PolyProblem& problem, const MomentRelaxation& relaxation, const sdp::SdpSummary& sdp,
+                          sdp::SdpSolver& used) {
+    const double sign = relaxation.objective_sign();
+    result.float_bound = sign * sdp.lower_bound;
+    if (!verify) return;
+    result.verification = sdp::VerifyOptimalSolve(options.verify, sdp_options, relaxation.lmi(),
+                                                  MomentVariableBounds(problem, relaxation), sdp, used);
+    result.verification.float_bound = result.float_bound;
+    if (result.verification.verified()) {
+      result.bound = sign * result.verification.bound;
+    } else {
+      result.message += "; " + result.verification.message;
+    }
+  };
   for (int round = 1; round <= options.max_rounds; ++round) {
     result.rounds = round;
     PolyProblem problem = core;
@@ -46,18 +67,41 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     MomentRelaxation relaxation(problem, order);
     result.num_moments = relaxation.lmi().c.size();
     result.num_blocks = relaxation.lmi().blocks.size();
-    auto sdp = solver.Solve(options.sdp, relaxation.lmi());
+    auto sdp = solver.Solve(sdp_options, relaxation.lmi());
+    sdp::SdpSolver* used = &solver;
     if (fallback && sdp.status != sdp::SdpStatus::kOptimal && sdp.status != sdp::SdpStatus::kInfeasible &&
         sdp.status != sdp::SdpStatus::kUnbounded) {
       const std::string first = sdp.message;
       result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
-      sdp = fallback->Solve(options.sdp, relaxation.lmi());
+      sdp = fallback->Solve(sdp_options, relaxation.lmi());
       sdp.message += " [after " + first + "]";
+      used = fallback;
     }
-    result.last_sdp = sdp;
     result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
     result.sdp_iterations += sdp.iterations;
     result.working_set.assign(working.begin(), working.end());
+    if (verify && sdp.status == sdp::SdpStatus::kInfeasible) {
+      // An emptiness claim stands only on a verified certificate; the other backend gets one chance to give one.
+      result.verification = sdp::VerifyInfeasibility(relaxation.lmi(), sdp.X, MomentVariableBounds(problem, relaxation));
+      if (!result.verification.verified() && fallback && used != fallback) {
+        auto second = fallback->Solve(sdp_options, relaxation.lmi());
+        result.solve_seconds += second.setup_seconds + second.solve_seconds;
+        if (second.status == sdp::SdpStatus::kInfeasible) {
+          auto v = sdp::VerifyInfeasibility(relaxation.lmi(), second.X, MomentVariableBounds(problem, relaxation));
+          v.seconds += result.verification.seconds;
+          if (v.verified()) sdp = std::move(second);
+          result.verification = v;
+        }
+      }
+      if (!result.verification.verified()) {
+        result.last_sdp = sdp;
+        result.status = RelaxationStatus::kSolverFailed;
+        result.message = fmt::format("relaxation reported infeasible, but {}: the set is NOT declared empty",
+                                     result.verification.message);
+        return result;
+      }
+    }
+    result.last_sdp = sdp;
     if (sdp.status == sdp::SdpStatus::kInfeasible) {
       result.status = RelaxationStatus::kInfeasible;
       result.message = fmt::format("relaxation with {} of {} data constraints is infeasible: the set is empty",
@@ -105,19 +149,69 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
       result.tight = true;
       result.message = fmt::format("tight: {} rounds, {} of {} data constraints in the LMI, none of the others violated",
                                    round, working.size(), candidates.size());
+      verify_bound(problem, relaxation, sdp, *used);
+      return result;
+    }
+    if (round == options.max_rounds) {
+      result.message = fmt::format("round limit reached: the bound is valid but may be looser than the full "
+                                   "relaxation's (max relative violation {:.2e})",
+                                   result.max_violation);
+      verify_bound(problem, relaxation, sdp, *used);
       return result;
     }
     std::sort(violated.rbegin(), violated.rend());
     for (int k = 0; k < std::min<int>(options.add_per_round, violated.size()); ++k) working.insert(violated[k].second);
   }
-  result.message = fmt::format("round limit reached: the bound is valid but may be looser than the full relaxation's "
-                               "(max relative violation {:.2e})",
-                               result.max_violation);
   return result;
 }
 
+sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const MomentRelaxation& relaxation) {
+  const int n = problem.num_vars;
+  const int m = relaxation.lmi().num_vars();
+  const double inf = std::numeric_limits<double>::infinity();
+  sdp::VariableBounds out = sdp::VariableBounds::Uniform(m, -inf, inf);
+  // Premise: 1 - x_i^2 >= 0 (up to a positive factor) for every variable i.
+  std::vector<char> boxed(n, 0);
+  auto check = [&](const Polynomial& g) {
+    if (g.terms().size() != 2) return;
+    const double a = g.constant_term();
+    if (!(a > 0)) return;
+    for (int i = 0; i < n; ++i) {
+      Exponents e(n, 0);
+      e[i] = 2;
+      if (g.coefficient(e) == -a) boxed[i] = 1;
+    }
+  };
+  for (const auto& g : problem.inequalities) check(g);
+  if (!problem.box.empty())
+    for (int i = 0; i < n; ++i)
+      if (problem.box[i].first == -1.0 && problem.box[i].second == 1.0) boxed[i] = 1;
+  if (std::find(boxed.begin(), boxed.end(), 0) != boxed.end()) return out;
+  // LMI variable z_f is bounded when some moment equals it exactly: y_k = 0 + 1 * z_f (checked on the map
+  // itself, through moments(): unit vectors give the columns of y = base + T z exactly).
+  const std::vector<double> base = relaxation.moments(std::vector<double>(m, 0.0));
+  std::vector<int> single(base.size(), -1);  // -1 unseen, >= 0 the one variable, -2 several or not 1.0
+  std::vector<double> z(m, 0.0);
+  for (int f = 0; f < m; ++f) {
+    z[f] = 1.0;
+    const auto y = relaxation.moments(z);
+    z[f] = 0.0;
+    for (std::size_t k = 1; k < y.size(); ++k) {
+      if (y[k] == base[k]) continue;
+      single[k] = (single[k] == -1 && base[k] == 0.0 && y[k] == 1.0) ? f : -2;
+    }
+  }
+  for (std::size_t k = 1; k < single.size(); ++k)
+    if (single[k] >= 0) {
+      out.lower[single[k]] = -1.0;
+      out.upper[single[k]] = 1.0;
+    }
+  return out;
+}
+
 sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constraints, int num_vars,
-                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver) {
+                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver,
+                                        sdp::VerifiedBound* certificate) {
   int D = 1;
   for (const auto& g : constraints) D = std::max(D, g.degree());
   const MonomialBasis basis(num_vars, D);
@@ -156,7 +250,23 @@ sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constrain
     lp.F[k].push_back({0, r, r, 1.0});
     ++r;
   }
-  return solver.Solve(options, lp);
+  if (!certificate) return solver.Solve(options, lp);
+  sdp::SdpOptions keep = options;
+  keep.keep_dual_matrix = true;
+  auto s = solver.Solve(keep, lp);
+  if (s.status == sdp::SdpStatus::kInfeasible) {
+    // Rows 1 - y >= 0 and 1 + y >= 0 hold for every feasible y of the LP.
+    *certificate = sdp::VerifyInfeasibility(lp, s.X, sdp::VariableBounds::Uniform(m, -1.0, 1.0));
+    if (!certificate->verified()) {
+      s.status = sdp::SdpStatus::kNumericalTrouble;
+      s.message += "; " + certificate->message;
+    }
+  }
+  if (!options.keep_dual_matrix) {
+    s.X.clear();
+    s.Z.clear();
+  }
+  return s;
 }
 
 }  // namespace hw::relax

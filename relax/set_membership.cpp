@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -41,10 +42,15 @@ struct JobOutcome {
   double seconds = 0.0;
   std::size_t moments = 0, blocks = 0;
   std::vector<int> working_set;
+  // Verification (sdp/verified_bound.hpp) of the bound or of the emptiness certificate: "off", "verified",
+  // "unverified"; bound is the verified value when verified, float_bound the solver's; both original units.
+  std::string verification = "off";
+  double float_bound = 0.0, correction = 0.0, verify_seconds = 0.0;
   nlohmann::json to_json() const {
     return {{"status", status}, {"bound", bound}, {"tight", tight}, {"message", message}, {"rounds", rounds},
             {"sdp_iterations", sdp_iterations}, {"seconds", seconds}, {"moments", moments}, {"blocks", blocks},
-            {"working_set", working_set}};
+            {"working_set", working_set}, {"verification", verification}, {"float_bound", float_bound},
+            {"correction", correction}, {"verify_seconds", verify_seconds}};
   }
   static JobOutcome from_json(const nlohmann::json& j) {
     JobOutcome o;
@@ -58,6 +64,10 @@ struct JobOutcome {
     o.moments = j.at("moments");
     o.blocks = j.at("blocks");
     o.working_set = j.at("working_set").get<std::vector<int>>();
+    o.verification = j.value("verification", std::string("off"));
+    o.float_bound = j.value("float_bound", o.bound);
+    o.correction = j.value("correction", 0.0);
+    o.verify_seconds = j.value("verify_seconds", 0.0);
     return o;
   }
 };
@@ -162,7 +172,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["prior_box_note"] = "intervals are guaranteed for parameters inside this box (a prior assumption)";
   auto ep = [](const Endpoint& e) {
     return nlohmann::json{{"value", e.value}, {"status", e.status}, {"note", e.note}, {"orthant", e.orthant},
-                          {"tight", e.tight}};
+                          {"tight", e.tight}, {"verification", e.verification}, {"correction", e.correction}};
   };
   for (const auto& iv : intervals)
     j["intervals"].push_back({{"parameter", iv.name}, {"lower", ep(iv.lower)}, {"upper", ep(iv.upper)},
@@ -208,7 +218,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                          {"cheap_pass", options.cheap_pass},
                          {"solver", options.solver}, {"box", set.box()},
                          {"violation_tolerance", options.generation.violation_tolerance},
-                         {"gap_tolerance", options.generation.sdp.gap_tolerance}};
+                         {"gap_tolerance", options.generation.sdp.gap_tolerance},
+                         {"verify", options.generation.verify.enabled}};
   uint64_t h = 1469598103934665603ull;
   const std::string meta_text = meta.dump();
   h = fnv(h, meta_text.data(), meta_text.size());
@@ -266,7 +277,10 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
           auto solver = sdp::MakeSolver(options.solver);
           sdp::SdpOptions lp_options = opts.generation.sdp;
           lp_options.keep_dual_matrix = false;
-          const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver);
+          // With verification on, emptiness needs a verified certificate (else the status is numerical trouble).
+          sdp::VerifiedBound cert;
+          const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver,
+                                                 opts.generation.verify.enabled ? &cert : nullptr);
           empty[l] = s.status == sdp::SdpStatus::kInfeasible;
           cache.store(key, {{"empty", static_cast<bool>(empty[l])}, {"status", sdp::ToString(s.status)}});
         },
@@ -350,11 +364,20 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     out.working_set = r.working_set;
     out.message = r.message;
     out.tight = r.tight;
+    out.verification = sdp::ToString(r.verification.status);
+    out.verify_seconds = r.verification.seconds;
     if (r.status == RelaxationStatus::kInfeasible) {
       out.status = "infeasible";
     } else if (r.status == RelaxationStatus::kSolved) {
       out.status = "solved";
+      out.float_bound = set.scaling().to_original(obj.param, r.float_bound);
       out.bound = set.scaling().to_original(obj.param, r.bound);
+      if (r.verification.verified()) {
+        // The affine map back to original units rounds twice: widen outward by a few ulps of its terms.
+        const auto [lo, hi] = set.box()[obj.param];
+        out.bound += obj.dir * 4 * std::numeric_limits<double>::epsilon() * (std::max(std::abs(lo), std::abs(hi)) + (hi - lo));
+        out.correction = std::abs(out.bound - out.float_bound);
+      }
     } else {
       out.status = "failed";
     }
@@ -460,29 +483,41 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
       Endpoint ep;
       ep.status = "empty";
       bool any = false;
+      // Verification: the endpoint is verified when every orthant value entering it is; float_value aggregates
+      // the solvers' floating-point bounds, so |value - float_value| is the endpoint's correction.
+      const bool verify = opts.generation.verify.enabled;
+      double float_value = 0.0;
+      std::string unverified;
       for (int l : alive) {
         if (is_empty(l)) continue;
         const auto& r = full.at({l, o});
-        double v;
-        std::string status = "guaranteed", note;
+        double v, fv;
+        std::string status = "guaranteed", note, ver;
         bool tight = r.tight;
         if (r.status == "solved" || r.status == "skipped") {
           v = r.bound;
+          fv = r.float_bound;
+          ver = r.verification;
         } else if (r.status == "infeasible") {
           continue;  // proven empty in this orthant
         } else {
           const auto& c = cheap.at({l, o});
           if (c.status == "solved" && options.order > cheap_order) {
             v = c.bound;
+            fv = c.float_bound;
+            ver = c.verification;
             note = fmt::format("order-{} solve failed in orthant {} ({}); order-{} bound used", options.order, l,
                                r.message, cheap_order);
           } else {
-            v = dir < 0 ? set.box()[k].first : set.box()[k].second;
+            v = fv = dir < 0 ? set.box()[k].first : set.box()[k].second;
+            ver = verify ? "verified" : "off";  // the prior box edge is exact
             note = fmt::format("solve failed in orthant {} ({}); box edge used", l, r.message);
           }
           status = "conservative";
           tight = false;
         }
+        if (verify && ver != "verified") unverified += (unverified.empty() ? "" : ", ") + std::to_string(l);
+        if (!any || (dir < 0 ? fv < float_value : fv > float_value)) float_value = fv;
         const bool better = !any || (dir < 0 ? v < ep.value : v > ep.value);
         // The endpoint's status is that of the orthant attaining it: a fallback that is not extreme
         // leaves the endpoint exact, since the fallback still bounds that orthant.
@@ -496,6 +531,13 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
         any = true;
       }
       if (!any) ep.note = "every orthant is proven empty: the data are inconsistent with the model class and box";
+      if (any) {
+        ep.verification = !verify ? "off" : unverified.empty() ? "verified" : "unverified";
+        ep.correction = std::abs(ep.value - float_value);
+        if (!unverified.empty())
+          ep.note += (ep.note.empty() ? "" : "; ") +
+                     fmt::format("floating-point bound not verified in orthant(s) {} (value is the solver's)", unverified);
+      }
       (dir < 0 ? iv.lower : iv.upper) = ep;
     }
     summary.intervals.push_back(iv);

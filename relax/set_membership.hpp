@@ -43,6 +43,10 @@ struct Endpoint {
   std::string note;
   int orthant = -1;                // orthant attaining the endpoint
   bool tight = false;              // equals the full relaxation's bound (constraint generation converged)
+  // "verified": every orthant bound entering the value was verified rigorously (sdp/verified_bound.hpp);
+  // "unverified": at least one is the solver's floating-point bound; "off": verification disabled.
+  std::string verification = "off";
+  double correction = 0.0;         // |value - the same endpoint from the solvers' floating-point bounds|
 };
 
 struct ParameterInterval {
