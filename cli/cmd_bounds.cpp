@@ -66,7 +66,7 @@ void AddBoundsCommand(CLI::App& app) {
     std::vector<std::string> box, params;
     double noise_bound = 0.0;
     int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
-    bool proper = false, no_cheap = false, quiet = false;
+    bool proper = false, no_cheap = false, quiet = false, verify = true;
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--data", o->data, "recording CSV with a header")->required();
@@ -86,6 +86,8 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--threads", o->threads, "parallel SDP jobs (default: all cores)");
   cmd->add_option("--run-dir", o->run_dir, "keep finished SDP results here; a rerun solves only the rest");
   cmd->add_flag("--no-cheap-pass", o->no_cheap, "solve every orthant at full order (no minimal-order screening)");
+  cmd->add_flag("--verify,!--no-verify", o->verify,
+                "verify every bound and emptiness certificate rigorously (interval arithmetic; default on)");
   cmd->add_option("--params", o->params, "only these intervals (names such as a1 b1; default: all)")->delimiter(',');
   cmd->add_option("--truth", o->truth, "comma list of true parameters, to report coverage (simulation studies)");
   cmd->add_option("--json", o->json_out, "write the result as JSON");
@@ -122,6 +124,7 @@ void AddBoundsCommand(CLI::App& app) {
     options.run_dir = o->run_dir;
     options.cheap_pass = !o->no_cheap;
     options.parameters = o->params;
+    options.generation.verify.enabled = o->verify;
     std::vector<double> truth;
     if (!o->truth.empty()) {
       truth = parse_list(o->truth, "--truth");
@@ -139,7 +142,8 @@ void AddBoundsCommand(CLI::App& app) {
       if (p.done == p.total) fmt::print(stderr, "\n");
     };
     const auto summary = relax::ComputeBounds(options, set, progress);
-    fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {}\n", "parameter", "lower", "upper", "half-width", "status");
+    fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {:<10} {:>19}  {}\n", "parameter", "lower", "upper", "half-width",
+               "verified", "correction lo/up", "status");
     bool covered = true;
     for (const auto& iv : summary.intervals) {
       const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
@@ -151,8 +155,11 @@ void AddBoundsCommand(CLI::App& app) {
         covered = covered && in;
         status += fmt::format("  truth {:.6g} {}", truth[k], in ? "inside" : "OUTSIDE");
       }
-      fmt::print("{:<10} {:>12.6f} {:>12.6f} {:>11.6f}  {}\n", iv.name, iv.lower.value, iv.upper.value,
-                 iv.half_width(), status);
+      const std::string verified = iv.lower.verification == iv.upper.verification
+                                       ? iv.lower.verification
+                                       : iv.lower.verification + "/" + iv.upper.verification;
+      fmt::print("{:<10} {:>12.6f} {:>12.6f} {:>11.6f}  {:<10} {:>9.1e}/{:<9.1e}  {}\n", iv.name, iv.lower.value,
+                 iv.upper.value, iv.half_width(), verified, iv.lower.correction, iv.upper.correction, status);
       for (const auto* ep : {&iv.lower, &iv.upper})
         if (!ep->note.empty()) fmt::print("           note: {}\n", ep->note);
     }
@@ -166,6 +173,17 @@ void AddBoundsCommand(CLI::App& app) {
                summary.largest_blocks, summary.median_solve_seconds, summary.wall_seconds);
     if (!summary.all_guaranteed())
       fmt::print("WARNING: some endpoints are conservative fallbacks (see notes); they are still valid bounds.\n");
+    if (o->verify) {
+      fmt::print("verification: {:.2f} s for {:.2f} s of SDP solves ({:.1f}%)\n", summary.verify_seconds,
+                 summary.solve_seconds, summary.solve_seconds > 0 ? 100 * summary.verify_seconds / summary.solve_seconds : 0.0);
+      for (const auto& iv : summary.intervals)
+        for (const auto* ep : {&iv.lower, &iv.upper})
+          if (ep->verification == "unverified") {
+            fmt::print("WARNING: {} has an endpoint that rests on an unverified floating-point bound (see notes).\n",
+                       iv.name);
+            break;
+          }
+    }
     if (!o->json_out.empty()) {
       auto j = summary.to_json();
       j["data"] = o->data;

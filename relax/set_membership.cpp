@@ -181,7 +181,8 @@ nlohmann::json BoundsSummary::to_json() const {
   j["counts"] = {{"orthants_total", orthants_total}, {"orthants_proven_empty", orthants_empty},
                  {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
                  {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache}};
-  j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds}};
+  j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds},
+                 {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds}};
   j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
   j["all_guaranteed"] = all_guaranteed();
   return j;
@@ -385,6 +386,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
       std::lock_guard<std::mutex> lock(mu);
       ++summary.sdp_jobs;
       summary.sdp_solves += r.rounds;
+      summary.solve_seconds += r.solve_seconds;
+      summary.verify_seconds += out.verify_seconds;
       solve_times.push_back(r.rounds ? r.solve_seconds / r.rounds : 0.0);
       summary.largest_moments = std::max(summary.largest_moments, r.num_moments);
       summary.largest_blocks = std::max(summary.largest_blocks, r.num_blocks);

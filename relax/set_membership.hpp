@@ -75,6 +75,7 @@ struct BoundsSummary {
   int sdp_solves = 0;         // SDP solves including constraint-generation rounds
   int jobs_from_cache = 0;
   double median_solve_seconds = 0.0;
+  double solve_seconds = 0.0, verify_seconds = 0.0;  // totals over the jobs run (cache excluded); verify incl. re-solves
   std::size_t largest_moments = 0, largest_blocks = 0;
   double wall_seconds = 0.0;
   int order = 0, horizon = 0;
