@@ -62,7 +62,7 @@ void AddBoundsCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("bounds", "Guaranteed parameter intervals (set-membership, paper 001) from a recording");
   struct Opts {
     std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
-    std::string solver = "sdpa", json_out, run_dir, truth;
+    std::string solver = "sdpa", json_out, run_dir, truth, executor = "fork";
     std::vector<std::string> box, params;
     double noise_bound = 0.0;
     int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
@@ -83,7 +83,11 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--order", o->order, "relaxation order delta (default: minimal order ceil((n+1)/2))");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI (default -10,10)");
   cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember({"csdp", "sdpa"}));
-  cmd->add_option("--threads", o->threads, "parallel SDP jobs (default: all cores)");
+  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; default: all cores)");
+  cmd->add_option("--executor", o->executor,
+                  "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "
+                  "coordinates, the other ranks solve)")
+      ->check(CLI::IsMember({"fork", "inprocess", "mpi"}));
   cmd->add_option("--run-dir", o->run_dir, "keep finished SDP results here; a rerun solves only the rest");
   cmd->add_flag("--no-cheap-pass", o->no_cheap, "solve every orthant at full order (no minimal-order screening)");
   cmd->add_flag("--verify,!--no-verify", o->verify,
@@ -121,10 +125,15 @@ void AddBoundsCommand(CLI::App& app) {
     options.order = o->order > 0 ? o->order : std::max(1, (o->horizon + 2) / 2);
     options.solver = o->solver;
     options.threads = o->threads;
+    options.executor = sdp::MakeExecutor(o->executor, o->threads);
     options.run_dir = o->run_dir;
     options.cheap_pass = !o->no_cheap;
     options.parameters = o->params;
     options.generation.verify.enabled = o->verify;
+    if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
+      relax::ComputeBounds(options, set);
+      return;
+    }
     std::vector<double> truth;
     if (!o->truth.empty()) {
       truth = parse_list(o->truth, "--truth");
@@ -132,9 +141,9 @@ void AddBoundsCommand(CLI::App& app) {
         throw InputError(fmt::format("--truth has {} values; the model has {} parameters", truth.size(), names.size()));
     }
     fmt::print("hwbounds bounds: {} samples from {}, na={} nb={} horizon n={} order delta={}, {} parameters, "
-               "{} sign orthants, solver {}\n",
+               "{} sign orthants, solver {}, jobs on {} ({} workers)\n",
                data.y.size(), o->data, o->na, o->nb, o->horizon, options.order, names.size(), set.num_orthants(),
-               o->solver);
+               o->solver, options.executor->name(), options.executor->workers());
     auto progress = [o](const relax::BoundsProgress& p) {
       if (o->quiet) return;
       fmt::print(stderr, "\r[{}] {}/{} jobs, elapsed {:.0f} s, ETA {:.0f} s   ", p.phase, p.done, p.total,

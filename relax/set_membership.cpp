@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "sdp/job_executor.hpp"
 
 namespace hw::relax {
 namespace fs = std::filesystem;
@@ -71,29 +72,6 @@ struct JobOutcome {
     return o;
   }
 };
-
-// Runs fn(i) for i in [0, n) on `threads` threads; reports progress after each job.
-void parallel_for(int threads, int n, const std::function<void(int)>& fn, const std::function<void(int)>& on_done) {
-  std::atomic<int> next{0}, done{0};
-  std::mutex report;
-  std::exception_ptr failure;
-  auto worker = [&] {
-    for (int i; (i = next++) < n;) {
-      try {
-        fn(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(report);
-        if (!failure) failure = std::current_exception();
-      }
-      std::lock_guard<std::mutex> lock(report);
-      if (on_done) on_done(++done);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 0; t < std::max(1, std::min(threads, n)); ++t) pool.emplace_back(worker);
-  for (auto& th : pool) th.join();
-  if (failure) std::rethrow_exception(failure);
-}
 
 uint64_t fnv(uint64_t h, const void* data, std::size_t n) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -165,6 +143,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["order"] = order;
   j["horizon"] = horizon;
   j["solver"] = solver;
+  j["executor"] = executor;
   nlohmann::json box_j = nlohmann::json::array();
   for (std::size_t i = 0; i < box.size(); ++i)
     box_j.push_back({{"parameter", parameter_names[i]}, {"lo", box[i].first}, {"hi", box[i].second}});
@@ -203,103 +182,15 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   const auto t0 = Clock::now();
   const int n = set.num_vars();
   const int L = set.num_orthants();
-  const int threads = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  int min_order = 1;
-  std::vector<std::vector<DataConstraint>> data(L);  // built lazily per orthant
-  {
-    // Minimal order from the constraint degrees: Remark 3, ceil((n + 1) / 2), and >= 1 for the box.
-    min_order = std::max(1, (set.horizon() + 2) / 2);
-  }
+  const std::shared_ptr<sdp::JobExecutor> executor =
+      options.executor ? options.executor : std::make_shared<sdp::ForkExecutor>(options.threads);
+  // Minimal order from the constraint degrees: Remark 3, ceil((n + 1) / 2), and >= 1 for the box.
+  const int min_order = std::max(1, (set.horizon() + 2) / 2);
   if (options.order < min_order)
     throw InputError(fmt::format("order {} is below the minimal order {} for horizon {}", options.order, min_order,
                                  set.horizon()));
 
-  // Problem hash for the run directory: everything that changes the numbers.
-  nlohmann::json meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
-                         {"cheap_pass", options.cheap_pass},
-                         {"solver", options.solver}, {"box", set.box()},
-                         {"violation_tolerance", options.generation.violation_tolerance},
-                         {"gap_tolerance", options.generation.sdp.gap_tolerance},
-                         {"verify", options.generation.verify.enabled}};
-  uint64_t h = 1469598103934665603ull;
-  const std::string meta_text = meta.dump();
-  h = fnv(h, meta_text.data(), meta_text.size());
-  for (int l = 0; l < std::min(L, 1); ++l)
-    for (const auto& c : set.data_constraints(l)) {
-      const std::string t = c.g.to_string();
-      h = fnv(h, t.data(), t.size());
-    }
-  const RunCache cache(options.run_dir, fmt::format("{:016x}", h), meta);
-
-  BoundsSummary summary;
-  summary.order = options.order;
-  summary.horizon = set.horizon();
-  summary.solver = options.solver;
-  summary.box = set.box();
-  summary.parameter_names = set.layout().names;
-  summary.orthants_total = L;
-
-  std::mutex mu;
-  std::vector<double> solve_times;
-  std::vector<std::string> orthant_status(L, "undecided");
-  std::map<std::pair<int, int>, std::set<int>> working;  // (orthant, order) -> data constraints in use
-  std::vector<std::vector<Polynomial>> candidates(L);
-  std::vector<std::once_flag> built(L);
-  auto candidates_of = [&](int l) -> const std::vector<Polynomial>& {
-    std::call_once(built[l], [&] {
-      for (auto& c : set.data_constraints(l)) candidates[l].push_back(std::move(c.g));
-    });
-    return candidates[l];
-  };
-  auto report = [&](const std::string& phase, int done, int total) {
-    if (!progress) return;
-    const double el = seconds_since(t0);
-    progress({phase, done, total, el, done > 0 ? el / done * (total - done) : 0.0});
-  };
-
-  // 1. LP screen.
-  std::vector<int> alive;
-  for (int l = 0; l < L; ++l) alive.push_back(l);
-  if (options.lp_screen) {
-    std::vector<char> empty(L, 0);
-    const auto t_phase = Clock::now();
-    parallel_for(
-        threads, L,
-        [&](int l) {
-          const std::string key = fmt::format("lp_l{}", l);
-          if (auto j = cache.load(key)) {
-            empty[l] = j->at("empty").get<bool>();
-            std::lock_guard<std::mutex> lock(mu);
-            ++summary.jobs_from_cache;
-            return;
-          }
-          std::vector<Polynomial> cons = set.sign_constraints(l);
-          for (const auto& g : candidates_of(l)) cons.push_back(g);
-          auto solver = sdp::MakeSolver(options.solver);
-          sdp::SdpOptions lp_options = opts.generation.sdp;
-          lp_options.keep_dual_matrix = false;
-          // With verification on, emptiness needs a verified certificate (else the status is numerical trouble).
-          sdp::VerifiedBound cert;
-          const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver,
-                                                 opts.generation.verify.enabled ? &cert : nullptr);
-          empty[l] = s.status == sdp::SdpStatus::kInfeasible;
-          cache.store(key, {{"empty", static_cast<bool>(empty[l])}, {"status", sdp::ToString(s.status)}});
-        },
-        [&](int done) {
-          (void)t_phase;
-          report("LP screen of orthants", done, L);
-        });
-    alive.clear();
-    for (int l = 0; l < L; ++l) {
-      if (empty[l]) {
-        orthant_status[l] = "empty (LP)";
-      } else {
-        alive.push_back(l);
-      }
-    }
-  }
-
-  // Objectives: min and max of every parameter.
+  // Objectives: min and max of every wanted parameter.
   std::vector<int> wanted;
   for (int k = 0; k < n; ++k)
     if (options.parameters.empty() ||
@@ -318,44 +209,48 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   }
   const int num_obj = static_cast<int>(objectives.size());
 
-  // One relaxation job: orthant l, objective o, order d.
-  auto run_job = [&](int l, int o, int d) -> JobOutcome {
-    const Objective obj = objectives[o];
-    const std::string key = fmt::format("o{}_l{}_{}_{}", d, l, set.layout().names[obj.param], obj.dir < 0 ? "min" : "max");
-    if (auto j = cache.load(key)) {
-      auto out = JobOutcome::from_json(*j);
-      std::lock_guard<std::mutex> lock(mu);
-      ++summary.jobs_from_cache;
-      working[{l, d}].insert(out.working_set.begin(), out.working_set.end());
-      return out;
+  std::vector<std::vector<Polynomial>> candidates(L);
+  std::vector<std::once_flag> built(L);
+  auto candidates_of = [&](int l) -> const std::vector<Polynomial>& {
+    std::call_once(built[l], [&] {
+      for (auto& c : set.data_constraints(l)) candidates[l].push_back(std::move(c.g));
+    });
+    return candidates[l];
+  };
+
+  // One job, as text, so that it can run in a forked worker or on another MPI rank. A job depends only on
+  // (options, set) and its spec: {"kind": "lp", "l"} screens orthant l; {"kind": "relax", "l", "o", "d",
+  // "initial"} bounds objective o over orthant l at order d, starting from the given working set.
+  const sdp::JobFunction job_function = [&](const std::string& text) -> std::string {
+    const auto spec = nlohmann::json::parse(text);
+    const int l = spec.at("l");
+    if (spec.at("kind") == "lp") {
+      std::vector<Polynomial> cons = set.sign_constraints(l);
+      for (const auto& g : candidates_of(l)) cons.push_back(g);
+      auto solver = sdp::MakeSolver(options.solver);
+      sdp::SdpOptions lp_options = opts.generation.sdp;
+      lp_options.keep_dual_matrix = false;
+      // With verification on, emptiness needs a verified certificate (else the status is numerical trouble).
+      sdp::VerifiedBound cert;
+      const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver,
+                                             opts.generation.verify.enabled ? &cert : nullptr);
+      return nlohmann::json{{"empty", s.status == sdp::SdpStatus::kInfeasible}, {"status", sdp::ToString(s.status)},
+                            {"verification", sdp::ToString(cert.status)}}
+          .dump();
     }
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      if (orthant_status[l].rfind("empty", 0) == 0) return {"infeasible", 0, false, "orthant already proven empty"};
-    }
+    const Objective obj = objectives.at(spec.at("o").get<std::size_t>());
     PolyProblem core;
     core.num_vars = n;
     core.objective = Polynomial::Variable(n, obj.param);
     core.maximize = obj.dir > 0;
     core.inequalities = set.box_constraints();
     for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(std::move(g));
-    std::vector<int> initial;
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      const auto& ws = working[{l, d}];
-      initial.assign(ws.begin(), ws.end());
-    }
     ConstraintGenerationOptions gen = opts.generation;
-    gen.order = d;
+    gen.order = spec.at("d");
     auto solver = sdp::MakeSolver(options.solver);
     auto other = sdp::MakeSolver(options.solver == "csdp" ? "sdpa" : "csdp");
-    const auto r = SolveWithConstraintGeneration(
-        gen, core, candidates_of(l), initial, *solver,
-        [&](const std::vector<int>& ws) {
-          std::lock_guard<std::mutex> lock(mu);
-          working[{l, d}].insert(ws.begin(), ws.end());
-        },
-        options.retry_with_other_solver ? other.get() : nullptr);
+    const auto r = SolveWithConstraintGeneration(gen, core, candidates_of(l), spec.at("initial").get<std::vector<int>>(),
+                                                 *solver, {}, options.retry_with_other_solver ? other.get() : nullptr);
     JobOutcome out;
     out.rounds = r.rounds;
     out.sdp_iterations = r.sdp_iterations;
@@ -382,19 +277,148 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     } else {
       out.status = "failed";
     }
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      ++summary.sdp_jobs;
-      summary.sdp_solves += r.rounds;
-      summary.solve_seconds += r.solve_seconds;
-      summary.verify_seconds += out.verify_seconds;
-      solve_times.push_back(r.rounds ? r.solve_seconds / r.rounds : 0.0);
-      summary.largest_moments = std::max(summary.largest_moments, r.num_moments);
-      summary.largest_blocks = std::max(summary.largest_blocks, r.num_blocks);
-      if (out.status == "infeasible") orthant_status[l] = fmt::format("empty (order {})", d);
+    return out.to_json().dump();
+  };
+
+  // Worker ranks (MPI) answer jobs until the coordinator ends the session; they report nothing themselves.
+  if (!executor->is_coordinator()) {
+    executor->Serve(job_function);
+    BoundsSummary worker;
+    worker.worker_rank = true;
+    return worker;
+  }
+  struct SessionEnd {  // also when the coordinator throws, so that no worker is left waiting
+    sdp::JobExecutor& e;
+    ~SessionEnd() { e.EndSession(); }
+  } session_end{*executor};
+
+  // Problem hash for the run directory: everything that changes the numbers.
+  nlohmann::json meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
+                         {"cheap_pass", options.cheap_pass},
+                         {"solver", options.solver}, {"box", set.box()},
+                         {"violation_tolerance", options.generation.violation_tolerance},
+                         {"gap_tolerance", options.generation.sdp.gap_tolerance},
+                         {"verify", options.generation.verify.enabled}};
+  uint64_t h = 1469598103934665603ull;
+  const std::string meta_text = meta.dump();
+  h = fnv(h, meta_text.data(), meta_text.size());
+  for (int l = 0; l < std::min(L, 1); ++l)
+    for (const auto& c : set.data_constraints(l)) {
+      const std::string t = c.g.to_string();
+      h = fnv(h, t.data(), t.size());
     }
-    cache.store(key, out.to_json());
-    return out;
+  const RunCache cache(options.run_dir, fmt::format("{:016x}", h), meta);
+
+  BoundsSummary summary;
+  summary.order = options.order;
+  summary.horizon = set.horizon();
+  summary.solver = options.solver;
+  summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
+  summary.box = set.box();
+  summary.parameter_names = set.layout().names;
+  summary.orthants_total = L;
+
+  std::vector<double> solve_times;
+  std::vector<std::string> orthant_status(L, "undecided");
+  std::map<std::pair<int, int>, std::set<int>> working;  // (orthant, order) -> data constraints in use
+  auto report = [&](const std::string& phase, int done, int total) {
+    if (!progress) return;
+    const double el = seconds_since(t0);
+    progress({phase, done, total, el, done > 0 ? el / done * (total - done) : 0.0});
+  };
+  auto is_empty = [&](int l) { return orthant_status[l].rfind("empty", 0) == 0; };
+
+  // 1. LP screen.
+  std::vector<int> alive;
+  for (int l = 0; l < L; ++l) alive.push_back(l);
+  if (options.lp_screen) {
+    std::vector<char> empty(L, 0);
+    std::vector<std::string> specs;
+    std::vector<int> spec_orthant;
+    for (int l = 0; l < L; ++l) {
+      if (auto j = cache.load(fmt::format("lp_l{}", l))) {
+        empty[l] = j->at("empty").get<bool>();
+        ++summary.jobs_from_cache;
+        continue;
+      }
+      specs.push_back(nlohmann::json{{"kind", "lp"}, {"l", l}}.dump());
+      spec_orthant.push_back(l);
+    }
+    int done = L - static_cast<int>(specs.size());
+    executor->Map(specs, job_function, [&](std::size_t i, const sdp::JobResult& r) {
+      const int l = spec_orthant[i];
+      if (r.ok) {  // a failed screen proves nothing: the orthant stays
+        const auto j = nlohmann::json::parse(r.text);
+        empty[l] = j.at("empty").get<bool>();
+        cache.store(fmt::format("lp_l{}", l), j);
+      }
+      report("LP screen of orthants", ++done, L);
+    });
+    alive.clear();
+    for (int l = 0; l < L; ++l) {
+      if (empty[l]) {
+        orthant_status[l] = "empty (LP)";
+      } else {
+        alive.push_back(l);
+      }
+    }
+  }
+
+  // Relaxation jobs (orthant l, objective o, order d): cached ones are read, the rest run on the executor.
+  // Bookkeeping (working sets shared between jobs of one orthant, emptiness, statistics) stays here.
+  auto run_jobs = [&](const std::vector<std::tuple<int, int, int>>& jobs, const std::string& phase,
+                      const std::function<void()>& on_each) {
+    std::vector<JobOutcome> outs(jobs.size());
+    std::vector<std::string> specs;
+    std::vector<std::size_t> spec_job;
+    auto key_of = [&](int l, int o, int d) {
+      const Objective obj = objectives[o];
+      return fmt::format("o{}_l{}_{}_{}", d, l, set.layout().names[obj.param], obj.dir < 0 ? "min" : "max");
+    };
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      const auto [l, o, d] = jobs[i];
+      if (auto j = cache.load(key_of(l, o, d))) {
+        outs[i] = JobOutcome::from_json(*j);
+        ++summary.jobs_from_cache;
+        working[{l, d}].insert(outs[i].working_set.begin(), outs[i].working_set.end());
+        if (on_each) on_each();
+        continue;
+      }
+      if (is_empty(l)) {
+        outs[i] = {"infeasible", 0, false, "orthant already proven empty"};
+        if (on_each) on_each();
+        continue;
+      }
+      const auto& ws = working[{l, d}];
+      specs.push_back(nlohmann::json{{"kind", "relax"}, {"l", l}, {"o", o}, {"d", d},
+                                     {"initial", std::vector<int>(ws.begin(), ws.end())}}
+                          .dump());
+      spec_job.push_back(i);
+    }
+    executor->Map(specs, job_function, [&](std::size_t s, const sdp::JobResult& r) {
+      const std::size_t i = spec_job[s];
+      const auto [l, o, d] = jobs[i];
+      JobOutcome& out = outs[i];
+      if (r.ok) {
+        out = JobOutcome::from_json(nlohmann::json::parse(r.text));
+      } else {  // a crashed or throwing job is a failed solve: reported, never dropped, not cached
+        out.status = "failed";
+        out.message = "job failed: " + r.error;
+      }
+      ++summary.sdp_jobs;
+      summary.sdp_solves += out.rounds;
+      summary.solve_seconds += out.seconds;
+      summary.verify_seconds += out.verify_seconds;
+      if (out.rounds) solve_times.push_back(out.seconds / out.rounds);
+      summary.largest_moments = std::max(summary.largest_moments, out.moments);
+      summary.largest_blocks = std::max(summary.largest_blocks, out.blocks);
+      working[{l, d}].insert(out.working_set.begin(), out.working_set.end());
+      if (out.status == "infeasible") orthant_status[l] = fmt::format("empty (order {})", d);
+      if (r.ok) cache.store(key_of(l, o, d), out.to_json());
+      (void)phase;
+      if (on_each) on_each();
+    });
+    return outs;
   };
 
   // 2. Cheap pass at the minimal order (also the final pass when order == minimal).
@@ -403,17 +427,16 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   const int cheap_order = options.cheap_pass ? std::min(options.order, std::max(min_order, 2)) : options.order;
   std::map<std::pair<int, int>, JobOutcome> cheap;  // (orthant, objective)
   {
-    std::vector<std::pair<int, int>> jobs;
-    for (int l : alive)
-      for (int o = 0; o < num_obj; ++o) jobs.push_back({l, o});
-    std::vector<JobOutcome> outs(jobs.size());
-    parallel_for(
-        threads, static_cast<int>(jobs.size()),
-        [&](int i) { outs[i] = run_job(jobs[i].first, jobs[i].second, cheap_order); },
-        [&](int done) { report(fmt::format("order {} relaxations", cheap_order), done, static_cast<int>(jobs.size())); });
-    for (std::size_t i = 0; i < jobs.size(); ++i) cheap[jobs[i]] = outs[i];
+    std::vector<std::tuple<int, int, int>> jobs;
+    for (int l : alive) {
+      candidates_of(l);  // built once here, shared with forked workers
+      for (int o = 0; o < num_obj; ++o) jobs.push_back({l, o, cheap_order});
+    }
+    int done = 0;
+    const std::string phase = fmt::format("order {} relaxations", cheap_order);
+    const auto outs = run_jobs(jobs, phase, [&] { report(phase, ++done, static_cast<int>(jobs.size())); });
+    for (std::size_t i = 0; i < jobs.size(); ++i) cheap[{std::get<0>(jobs[i]), std::get<1>(jobs[i])}] = outs[i];
   }
-  auto is_empty = [&](int l) { return orthant_status[l].rfind("empty", 0) == 0; };
 
   // 3. Full pass: per objective, orthants by cheap bound (most extreme first), skipped when unable to move it.
   std::map<std::pair<int, int>, JobOutcome> full = cheap;
@@ -448,11 +471,10 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
         if (best >= 0) wave.push_back({best, o});
       }
       if (wave.empty()) break;
-      std::vector<JobOutcome> outs(wave.size());
-      parallel_for(
-          threads, static_cast<int>(wave.size()),
-          [&](int i) { outs[i] = run_job(wave[i].first, wave[i].second, options.order); },
-          [&](int) { report(fmt::format("order {} relaxations", options.order), ++finished, total_est); });
+      std::vector<std::tuple<int, int, int>> wave_jobs;
+      for (const auto& [l, o] : wave) wave_jobs.push_back({l, o, options.order});
+      const std::string phase = fmt::format("order {} relaxations", options.order);
+      const auto outs = run_jobs(wave_jobs, phase, [&] { report(phase, ++finished, total_est); });
       for (std::size_t i = 0; i < wave.size(); ++i) {
         const auto [l, o] = wave[i];
         done_jobs.insert({l, o});

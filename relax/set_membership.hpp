@@ -14,6 +14,7 @@
 // D^ss(n) intersected with the prior box. A failed solve never disappears: the endpoint falls back to
 // the same orthant's cheap-order bound, or to the box edge, and is marked "conservative".
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 
 #include "relax/constraint_generation.hpp"
 #include "relax/hw_outer_set.hpp"
+#include "sdp/job_executor.hpp"
 
 namespace hw::relax {
 
@@ -30,7 +32,11 @@ struct BoundsOptions {
   bool lp_screen = true;
   std::string solver = "sdpa";
   bool retry_with_other_solver = true;  // a failed solve is repeated with the other backend before falling back
-  int threads = 0;               // 0 = all cores
+  // Local parallel jobs. CSDP and SDPA are not thread-safe, so jobs run in forked worker processes
+  // (sdp::ForkExecutor); 0 = one per core. Ignored when `executor` is set.
+  int threads = 0;
+  // Where jobs run (sdp/job_executor.hpp): null = ForkExecutor(threads); sdp::MpiExecutor for MPI runs.
+  std::shared_ptr<sdp::JobExecutor> executor;
   std::string run_dir;           // resumable cache; empty = none
   std::vector<std::string> parameters;  // intervals to compute (names); empty = every parameter
   ConstraintGenerationOptions generation;  // its order is set per pass
@@ -80,6 +86,8 @@ struct BoundsSummary {
   double wall_seconds = 0.0;
   int order = 0, horizon = 0;
   std::string solver;
+  std::string executor;       // e.g. "fork (2 workers)"
+  bool worker_rank = false;   // true on MPI worker ranks: they served jobs and hold no result
   std::vector<std::pair<double, double>> box;
   std::vector<std::string> parameter_names;
   nlohmann::json to_json() const;
