@@ -240,4 +240,94 @@ TEST(Esmaeilani, PaperValveBlockMapsToProjectConvention) {
   for (std::size_t t = 0; t < u.size(); ++t) EXPECT_NEAR(c[t], d[t], 1e-9);
 }
 
+
+TEST(Esmaeilani, KnownOutputRangeSaturatesOnlyAtTheLimits) {
+  // g^{-1}(y) = 2 y on y in [20, 80] (the identified pairs): g(z) = z / 2 on z in [40, 160].
+  EsmaeilaniModel m;
+  m.y_grid = {20, 50, 80};
+  m.ginv_values = {40, 100, 160};
+  const StaticMap held = m.OutputMap(true);  // no known range: held beyond the identified pairs
+  EXPECT_NEAR(held(20.0), 20.0, 1e-12);
+  EXPECT_NEAR(held(190.0), 80.0, 1e-12);
+  m.has_output_range = true;
+  m.output_lower = 0.0;
+  m.output_upper = 100.0;
+  const StaticMap g = m.OutputMap(true);  // linear up to the known limits, then saturated
+  EXPECT_NEAR(g(20.0), 10.0, 1e-12);
+  EXPECT_NEAR(g(190.0), 95.0, 1e-12);
+  EXPECT_NEAR(g(200.0), 100.0, 1e-12);
+  EXPECT_NEAR(g(260.0), 100.0, 1e-12);
+  EXPECT_NEAR(g(-5.0), 0.0, 1e-12);
+  const auto c = Constraints::FromJson(nlohmann::json::parse(R"({"output_range": [0, 100], "saturation_tolerance": 1})"),
+                                       "c.json");
+  EXPECT_TRUE(c.has_output_range);
+  EXPECT_EQ(c.output_upper, 100.0);
+  EXPECT_EQ(c.saturation_tolerance, 1.0);
+  EXPECT_THROW(Constraints::FromJson(nlohmann::json::parse(R"({"output_range": [100, 0]})"), "c.json"), InputError);
+  EXPECT_THROW(Constraints::FromJson(nlohmann::json::parse(R"({"saturation_tolerance": 1})"), "c.json"), InputError);
+}
+
+TEST(Esmaeilani, SaturationHandlingNeedsItsAssumptions) {
+  auto segs = NoisyData(2, 80);
+  Options opt;
+  opt.order = 2;
+  opt.grid_f = 5;
+  opt.grid_g = 6;
+  Constraints c = Normalisation();
+  c.has_output_range = true;
+  c.output_lower = -10.0;
+  c.output_upper = 10.0;
+  c.saturation_tolerance = 0.1;
+  c.fix_d_zero = false;  // censoring with feedthrough is refused
+  EXPECT_THROW(Estimate(opt, segs, c, nullptr), InputError);
+  c.fix_d_zero = true;  // ... and without a known direction of g^{-1}
+  EXPECT_THROW(Estimate(opt, segs, c, nullptr), InputError);
+  c.g_inverse.slopes = {{-1e20, 1e20, 0.0, 1e20}};
+  Summary sum;
+  Estimate(opt, segs, c, &sum);
+  EXPECT_EQ(sum.censored_samples, 0);  // no sample near +-10
+  EXPECT_TRUE(sum.ok()) << sum.message;
+}
+
+TEST(Esmaeilani, IpoptAndCgalSolveTheSameQp) {
+  // min 1/2 x^T H x + c^T x with H = [[2, 1], [1, 4]], c = [-1, -6], s.t. x0 + x1 <= 1, x0 >= 0.2.
+  SparseQp qp;
+  qp.H.resize(2, 2);
+  qp.H.insert(0, 0) = 2.0;
+  qp.H.insert(1, 0) = 1.0;
+  qp.H.insert(0, 1) = 1.0;
+  qp.H.insert(1, 1) = 4.0;
+  qp.c = Eigen::Vector2d(-1.0, -6.0);
+  qp.A.resize(1, 2);
+  qp.A.insert(0, 0) = 1.0;
+  qp.A.insert(0, 1) = 1.0;
+  qp.row_lower = Eigen::VectorXd::Constant(1, -1e20);
+  qp.row_upper = Eigen::VectorXd::Constant(1, 1.0);
+  qp.var_lower = Eigen::Vector2d(0.2, -1e20);
+  qp.var_upper = Eigen::Vector2d(1e20, 1e20);
+  // Unconstrained minimiser H^{-1}(-c) = (-2/7, 11/7) violates x0 >= 0.2; with x0 = 0.2: x1 = (6 - 0.2)/4 = 1.45,
+  // x0 + x1 = 1.65 > 1, so both constraints bind: x = (0.2, 0.8).
+  for (auto backend : {QpOptions::Backend::kIpopt, QpOptions::Backend::kCgal}) {
+    QpOptions o;
+    o.backend = backend;
+    Eigen::VectorXd x = Eigen::Vector2d(0.0, 0.0);
+    const QpSummary s = SolveQp(o, qp, &x);
+    ASSERT_TRUE(s.solved) << s.message;
+    EXPECT_NEAR(x[0], 0.2, 1e-7);
+    EXPECT_NEAR(x[1], 0.8, 1e-7);
+    EXPECT_NEAR(s.objective, 0.5 * (2 * 0.04 + 2 * 0.16 + 4 * 0.64) - 0.2 - 4.8, 1e-7);
+  }
+  qp.row_lower[0] = 2.0;  // x0 + x1 >= 2 with x0 <= 1, x1 <= 0: infeasible, both must say so
+  qp.row_upper[0] = 1e20;
+  qp.var_upper = Eigen::Vector2d(1.0, 0.0);
+  for (auto backend : {QpOptions::Backend::kIpopt, QpOptions::Backend::kCgal}) {
+    QpOptions o;
+    o.backend = backend;
+    Eigen::VectorXd x = Eigen::Vector2d(0.0, 0.0);
+    const QpSummary s = SolveQp(o, qp, &x);
+    EXPECT_FALSE(s.solved);
+    EXPECT_TRUE(s.infeasible) << s.message;
+  }
+}
+
 }  // namespace

@@ -149,6 +149,7 @@ struct Problem {
   Eigen::SparseMatrix<double> C;                 // linear constraints on alpha
   Eigen::VectorXd c_lower, c_upper;
   bool fix_d_zero = false;
+  std::vector<char> censored;  // per sample: 1 = y at a known saturation (output equation dropped)
 
   // Residual theta(alpha) and, if J != nullptr, its Jacobian.
   void Evaluate(const Eigen::VectorXd& al, Eigen::VectorXd* r, Eigen::SparseMatrix<double>* J) const {
@@ -186,6 +187,10 @@ struct Problem {
         }
       }
       for (int k = 0; k < N; ++k, ++row) {  // output equations
+        if (!censored.empty() && censored[off + k]) {  // replaced by an inequality row in C
+          (*r)[row] = 0.0;
+          continue;
+        }
         const double input = F[off + k] + al[L.v(S, k)];
         (*r)[row] = wo * (G[off + k] - al[L.x(S, k, n - 1)] - d * input - al[L.offset()]);
         if (!J) continue;
@@ -284,14 +289,30 @@ Constraints Constraints::FromJson(const nlohmann::json& j, const std::string& so
   try {
     if (!j.is_object()) throw InputError(source + ": constraints must be a JSON object");
     for (const auto& [key, value] : j.items())
-      if (key != "f" && key != "g_inverse" && key != "d" && key != "comment")
-        throw InputError(fmt::format("{}: unknown key '{}'; expected f, g_inverse, d, comment", source, key));
+      if (key != "f" && key != "g_inverse" && key != "d" && key != "output_range" && key != "saturation_tolerance" &&
+          key != "comment")
+        throw InputError(fmt::format(
+            "{}: unknown key '{}'; expected f, g_inverse, d, output_range, saturation_tolerance, comment", source, key));
     if (j.contains("f")) c.f = FunctionFromJson(j.at("f"), source + ": f");
     if (j.contains("g_inverse")) c.g_inverse = FunctionFromJson(j.at("g_inverse"), source + ": g_inverse");
     if (j.contains("d")) {
       if (!j.at("d").is_number() || j.at("d").get<double>() != 0.0)
         throw InputError(source + ": d: only \"d\": 0 (no direct feedthrough) is supported");
       c.fix_d_zero = true;
+    }
+    if (j.contains("output_range")) {
+      const auto r = j.at("output_range").get<std::vector<double>>();
+      if (r.size() != 2 || !(r[0] < r[1]))
+        throw InputError(source + ": output_range: expected [lower, upper] with lower < upper");
+      c.has_output_range = true;
+      c.output_lower = r[0];
+      c.output_upper = r[1];
+    }
+    if (j.contains("saturation_tolerance")) {
+      c.saturation_tolerance = j.at("saturation_tolerance").get<double>();
+      if (!c.has_output_range || !(c.saturation_tolerance >= 0))
+        throw InputError(source + ": saturation_tolerance needs output_range and a value >= 0 (the bound on the "
+                         "output measurement noise, in units of y)");
     }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: {}", source, e.what()));
@@ -316,6 +337,8 @@ Constraints Constraints::Load(const std::string& path) {
 nlohmann::json Constraints::ToJson() const {
   nlohmann::json j = {{"f", FunctionToJson(f)}, {"g_inverse", FunctionToJson(g_inverse)}};
   if (fix_d_zero) j["d"] = 0;
+  if (has_output_range) j["output_range"] = {output_lower, output_upper};
+  if (saturation_tolerance >= 0) j["saturation_tolerance"] = saturation_tolerance;
   return j;
 }
 
@@ -356,6 +379,21 @@ StaticMap EsmaeilaniModel::OutputMap(bool clamp) const {
     k = e;
   }
   if (xs.size() == 1) return StaticMap::PiecewiseLinear({xs[0] - 1, xs[0] + 1}, {ws[0], ws[0]});
+  if (clamp && has_output_range) {
+    // Extend the end pieces linearly until they reach the known output limits, then hold: the plant's
+    // output saturates at its physical limits, not where the estimation data happened to stop.
+    for (double& w : ws) w = std::clamp(w, output_lower, output_upper);
+    const std::size_t e = xs.size() - 1;
+    const double s0 = (ws[1] - ws[0]) / (xs[1] - xs[0]), s1 = (ws[e] - ws[e - 1]) / (xs[e] - xs[e - 1]);
+    if (s1 != 0.0) {
+      const double target = s1 > 0 ? output_upper : output_lower;
+      if (target != ws[e]) xs.push_back(xs[e] + (target - ws[e]) / s1), ws.push_back(target);
+    }
+    if (s0 != 0.0) {
+      const double target = s0 > 0 ? output_lower : output_upper;
+      if (target != ws[0]) xs.insert(xs.begin(), xs[0] + (target - ws[0]) / s0), ws.insert(ws.begin(), target);
+    }
+  }
   if (clamp) {  // flat end pieces: the piecewise-linear map then extrapolates as a constant
     const double step = (xs.back() - xs.front()) / static_cast<double>(xs.size() - 1);
     xs.insert(xs.begin(), xs.front() - step);
@@ -426,6 +464,7 @@ nlohmann::json EsmaeilaniModel::ToJson() const {
           {"b", b},
           {"d", d},
           {"output_offset", output_offset},
+          {"output_range", has_output_range ? nlohmann::json{output_lower, output_upper} : nlohmann::json()},
           {"f_pairs", {{"u", u_grid}, {"f", f_values}}},
           {"g_inverse_pairs", {{"y", y_grid}, {"g_inverse", ginv_values}}},
           {"initial_states", initial_states}};
@@ -478,6 +517,9 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
   EsmaeilaniModel m;
   m.u_grid = grid_for(all_u, constraints.f, L.gf, "input");
   m.y_grid = grid_for(all_y, constraints.g_inverse, L.gg, "output");
+  m.has_output_range = constraints.has_output_range;
+  m.output_lower = constraints.output_lower;
+  m.output_upper = constraints.output_upper;
 
   sum.unknowns = L.size() - (constraints.fix_d_zero ? 1 : 0) - (options.estimate_output_offset ? 0 : 1);
   RequirePinned(constraints.f, "f", "f -> c f, b -> b / c leaves the model unchanged while the input-noise term v "
@@ -485,12 +527,42 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
   RequirePinned(constraints.g_inverse, "g_inverse",
                 "g^{-1} -> c g^{-1}, x -> c x, b -> c b shrinks every residual as c -> 0 (the trivial solution "
                 "g^{-1} = const, b = 0)");
+  // Samples at a known output saturation (censored): their output equation becomes an inequality.
+  int censored_count = 0;
+  bool ginv_increasing = true;
+  if (constraints.saturation_tolerance >= 0) {
+    if (!constraints.has_output_range)
+      throw InputError("constraints: saturation_tolerance needs output_range (the known limits of y)");
+    if (!constraints.fix_d_zero)
+      throw InputError("constraints: saturation handling needs \"d\": 0 (with direct feedthrough the saturated "
+                       "output would depend bilinearly on d and f)");
+    // The direction of g^{-1} decides which side of the threshold the state is on; it must be known.
+    bool up = false, down = false;
+    for (const auto& sl : constraints.g_inverse.slopes)
+      if (sl.from <= constraints.output_lower && sl.to >= constraints.output_upper) {
+        up |= sl.lower >= 0;
+        down |= sl.upper <= 0;
+      }
+    if (up == down)
+      throw InputError("constraints: saturation handling needs a monotone g_inverse: give a g_inverse slope limit "
+                       "over the whole output range with min >= 0 (or max <= 0)");
+    ginv_increasing = up;
+    P.censored.assign(all_y.size(), 0);
+    for (std::size_t i = 0; i < all_y.size(); ++i)
+      if (all_y[i] >= constraints.output_upper - constraints.saturation_tolerance ||
+          all_y[i] <= constraints.output_lower + constraints.saturation_tolerance) {
+        P.censored[i] = 1;
+        ++censored_count;
+      }
+  }
+  sum.censored_samples = censored_count;
   // Each sample gives one output equation and n state equations but adds n states and one noise term;
   // the model is identifiable only if the samples outnumber the remaining unknowns.
   const int free_params = L.gf + L.gg + 2 * n + (constraints.fix_d_zero ? 0 : 1) +
                           (options.estimate_output_offset ? 1 : 0);
   int informative = 0;
   for (int len : L.seg_len) informative += len - n;
+  informative -= censored_count;
   sum.equations = L.rows();
   if (informative < free_params)
     throw InputError(fmt::format(
@@ -508,6 +580,31 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
   std::vector<double> lo, hi;
   AddFunctionConstraints(constraints.f, m.u_grid, L.f(0), &ct, &lo, &hi);
   AddFunctionConstraints(constraints.g_inverse, m.y_grid, L.g(0), &ct, &lo, &hi);
+  if (censored_count > 0) {
+    // A sample whose measured y is within `tol` of a known output limit only says that the true output
+    // is within 2 tol of the limit: w_t >= upper - 2 tol, i.e. C x_t + m_e >= g^{-1}(upper - 2 tol) for an
+    // increasing g^{-1} (<= at the lower limit; mirrored for a decreasing one). This inequality replaces
+    // the output equation, which cannot hold there: behind a saturation many states share one y
+    // (g^{-1} is not one-to-one, paper Fig. 6b), and their equation residuals would bias f and the
+    // linear block (see docs/esmaeilani.md).
+    const double tol = constraints.saturation_tolerance;
+    for (std::size_t s = 0; s < L.seg_len.size(); ++s)
+      for (int k = 0; k < L.seg_len[s]; ++k) {
+        const int sample = L.seg_start[s] + k;
+        if (!P.censored[sample]) continue;
+        const bool at_upper = all_y[sample] >= constraints.output_upper - tol;
+        const double level = at_upper ? constraints.output_upper - 2 * tol : constraints.output_lower + 2 * tol;
+        const auto [kk, w] = Bracket(m.y_grid, level);
+        const int r = static_cast<int>(lo.size());
+        ct.emplace_back(r, L.x(static_cast<int>(s), k, n - 1), 1.0);
+        ct.emplace_back(r, L.offset(), 1.0);
+        ct.emplace_back(r, L.g(kk), -(1 - w));
+        ct.emplace_back(r, L.g(kk + 1), -w);
+        const bool state_above = at_upper == ginv_increasing;  // C x_t + m_e - g^{-1}(level) >= 0 ?
+        lo.push_back(state_above ? 0.0 : -kInf);
+        hi.push_back(state_above ? kInf : 0.0);
+      }
+  }
   P.C.resize(static_cast<int>(lo.size()), L.size());
   P.C.setFromTriplets(ct.begin(), ct.end());
   P.c_lower = Eigen::Map<Eigen::VectorXd>(lo.data(), lo.size());
@@ -540,15 +637,16 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
 
   SparseQp qp;
   qp.A = P.C;
-  int iter = 0;
   double cost = Cost(P, al);
   sum.initial_cost = cost;
   sum.cost_history.push_back(cost);
   sum.status = Summary::Status::kMaxIterations;
   double lambda = options.damping;  // Levenberg-Marquardt weight, adapted from the accepted step length
-  for (iter = 0; iter < options.max_iterations; ++iter) {
-    // Iteration 0 holds (a, b, d): the problem is then linear in the rest and one QP solves it exactly.
-    const bool hold_linear = iter == 0;
+  // One convex QP on the linearised residual and a backtracking line search. hold_linear fixes (a, b, d):
+  // the residual is then linear in the remaining unknowns, so the QP (undamped) gives their exact minimiser.
+  // Returns false if the QP failed (message set) or no descent was found.
+  enum class StepResult { kOk, kNoDescent, kQpFailed };
+  auto step_once = [&](bool hold_linear, bool first) -> StepResult {
     const auto setup_start = Clock::now();
     Eigen::VectorXd r;
     Eigen::SparseMatrix<double> J;
@@ -557,12 +655,13 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
     const Eigen::SparseMatrix<double> Jt = J.transpose();
     Eigen::SparseMatrix<double> JtJ = Jt * J;
     Eigen::VectorXd diag = JtJ.diagonal();
+    const double lam = hold_linear ? 0.0 : lambda;
     Eigen::SparseMatrix<double> reg(L.size(), L.size());
     std::vector<Eigen::Triplet<double>> rt;
-    for (int i = 0; i < L.size(); ++i) rt.emplace_back(i, i, lambda * diag[i] + 1e-12);
+    for (int i = 0; i < L.size(); ++i) rt.emplace_back(i, i, lam * diag[i] + 1e-12);
     reg.setFromTriplets(rt.begin(), rt.end());
     qp.H = 2.0 * (JtJ + reg);
-    qp.c = 2.0 * (J.transpose() * r);
+    qp.c = 2.0 * (Jt * r);
     const Eigen::VectorXd Cal = P.C * al;
     qp.row_lower = P.c_lower - Cal;
     qp.row_upper = P.c_upper - Cal;
@@ -582,19 +681,14 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
     const QpSummary qs = SolveQp(options.qp, qp, &step);
     sum.qp_seconds += std::chrono::duration<double>(Clock::now() - qp_start).count();
     sum.qp_iterations += qs.iterations;
+    ++sum.qp_solves;
     if (!qs.solved) {
-      if (iter == 0 && qs.infeasible)
+      if (first && qs.infeasible)
         throw InputError(
             "esmaeilani: the constraints contradict each other (no f', g' satisfy all ranges, slopes and known "
             "points); check the constraints file");
-      if (iter == 0) {
-        sum.status = Summary::Status::kFailed;
-        sum.message = "first QP failed: " + qs.message;
-        break;
-      }
-      sum.status = Summary::Status::kConverged;
-      sum.message = "stopped: QP subproblem did not solve (" + qs.message + "); kept the last iterate";
-      break;
+      sum.message = qs.message;
+      return StepResult::kQpFailed;
     }
     // Backtracking on the step length (every point of the segment satisfies the linear constraints).
     double t = 1.0, new_cost = Cost(P, al + step);
@@ -602,18 +696,39 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
       t *= 0.5;
       new_cost = Cost(P, al + t * step);
     }
-    if (new_cost > cost) {
+    if (new_cost > cost) return StepResult::kNoDescent;
+    al += t * step;
+    cost = new_cost;
+    if (!hold_linear) {
+      sum.step_lengths.push_back(t);
+      lambda = t == 1.0 ? std::max(lambda / 3.0, options.damping) : std::min(lambda * 4.0 / t, 1e8);
+    }
+    return StepResult::kOk;
+  };
+  // Iteration 0 holds (a, b, d): the problem is then linear in the rest and one QP solves it exactly.
+  int iter = 0;
+  for (iter = 0; iter < options.max_iterations; ++iter) {
+    const double before = cost;
+    StepResult res = step_once(iter == 0, iter == 0);
+    if (res == StepResult::kOk && iter > 0 && options.reproject) res = step_once(true, false);
+    if (res == StepResult::kQpFailed) {
+      if (iter == 0) {
+        sum.status = Summary::Status::kFailed;
+        sum.message = "first QP failed: " + sum.message;
+      } else {
+        sum.status = Summary::Status::kConverged;
+        sum.message = "stopped: QP subproblem did not solve (" + sum.message + "); kept the last iterate";
+      }
+      break;
+    }
+    if (res == StepResult::kNoDescent) {
       sum.status = Summary::Status::kConverged;
       sum.message = "converged: no descent along the Gauss-Newton step";
       break;
     }
-    al += t * step;
-    const double decrease = (cost - new_cost) / std::max(cost, 1e-300);
-    cost = new_cost;
     sum.cost_history.push_back(cost);
-    sum.step_lengths.push_back(t);
-    if (!hold_linear) lambda = t == 1.0 ? std::max(lambda / 3.0, options.damping) : std::min(lambda * 4.0 / t, 1e8);
-    if (!hold_linear && (decrease < options.relative_decrease || cost < 1e-24)) {
+    const double decrease = (before - cost) / std::max(before, 1e-300);
+    if (iter > 0 && (decrease < options.relative_decrease || cost < 1e-24)) {
       sum.status = Summary::Status::kConverged;
       sum.message = fmt::format("converged: relative decrease {:.3g} below {:.3g}", decrease,
                                 options.relative_decrease);

@@ -101,6 +101,7 @@ class QpTnlp : public Ipopt::TNLP {
 }  // namespace
 
 QpSummary SolveQp(const QpOptions& options, const SparseQp& qp, Eigen::VectorXd* x) {
+  if (options.backend == QpOptions::Backend::kCgal) return SolveQpCgal(options, qp, x);
   QpSummary summary;
   Ipopt::SmartPtr<QpTnlp> tnlp = new QpTnlp(qp, x);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();

@@ -17,6 +17,10 @@ struct SparseQp {
 };
 
 struct QpOptions {
+  // kIpopt: interior point with sparse LDL^T (default; see docs/esmaeilani.md for the measured comparison).
+  // kCgal: CGAL's exact simplex-type QP solver (Gmpzf arithmetic), a second independent backend.
+  enum class Backend { kIpopt, kCgal };
+  Backend backend = Backend::kIpopt;
   double tolerance = 1e-9;
   int max_iterations = 500;
   int print_level = 0;
@@ -32,5 +36,6 @@ struct QpSummary {
 
 // x: on input the starting point (need not be feasible), on output the solution.
 QpSummary SolveQp(const QpOptions& options, const SparseQp& qp, Eigen::VectorXd* x);
+QpSummary SolveQpCgal(const QpOptions& options, const SparseQp& qp, Eigen::VectorXd* x);  // cgal_qp.cpp
 
 }  // namespace hw::esmaeilani

@@ -15,6 +15,9 @@ EsmaeilaniModel ValveCase::TrueModel(int grid) const {
   m.a = a;
   m.b = b;
   m.d = d;
+  m.has_output_range = true;
+  m.output_lower = 0.0;
+  m.output_upper = 100.0;
   // f exactly as ordered pairs (kink at the dead-band start); g^{-1} on the unsaturated range,
   // with OutputMap's clamping giving the hard saturation.
   m.u_grid = {0.0, dead_band_start, 100.0};
@@ -69,6 +72,9 @@ Segment ValveCase::ClosingOperation(unsigned seed, int samples, std::vector<doub
 Constraints ValveCase::KnownInformation() const {
   Constraints c;
   c.fix_d_zero = true;
+  c.has_output_range = true;  // valve travel: 0 % (closed) .. 100 % (fully open)
+  c.output_lower = 0.0;
+  c.output_upper = 100.0;
   c.f.has_range = true;
   c.f.range_lower = 0.0;
   c.f.range_upper = 100.0;
