@@ -13,6 +13,7 @@ void AddDiagnoseCommand(CLI::App& app);
 void AddScenarioCommand(CLI::App& app);
 void AddBrouriCommand(CLI::App& app);
 void AddEsmaeilaniCommand(CLI::App& app);
+void AddCompareCommand(CLI::App& app);
 // Further commands are declared here as their modules land (bounds, brouri, esmaeilani, diagnose, compare).
 
 }  // namespace hw::cli

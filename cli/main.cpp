@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   hw::cli::AddScenarioCommand(app);
   hw::cli::AddBrouriCommand(app);
   hw::cli::AddEsmaeilaniCommand(app);
+  hw::cli::AddCompareCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,205 @@
+// Comparison studies (compare/): scenario adapters against the paper simulators, a small end-to-end study
+// whose tables are recomputed from its per-run files, coverage of every guaranteed interval, resume, and
+// clear errors for bad scenarios.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "compare/methods.hpp"
+#include "compare/study.hpp"
+#include "core/cerone_example.hpp"
+#include "core/csv_table.hpp"
+
+namespace hw::compare {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  return json::parse(in);
+}
+
+TEST(CompareScenario, RandomInputRecordReproducesThePaperSimulator) {
+  const auto s = LoadScenario("setmembership-example");
+  double bound = 0.0;
+  const auto r = RandomInputRecord(s.plant, s.input_lo, s.input_hi, 80, 31.0, 0.0, 7, &bound);
+  const auto ex = SimulateCeroneExample(7, 80, 31.0);
+  ASSERT_EQ(r.y.size(), ex.y.size());
+  EXPECT_NEAR(bound, ex.noise_bound, 1e-9 * ex.noise_bound);
+  for (std::size_t t = 0; t < r.y.size(); ++t) {
+    EXPECT_EQ(r.u[t], ex.u[t]);
+    EXPECT_NEAR(r.w[t], ex.w[t], 1e-9) << t;
+    EXPECT_NEAR(r.y[t], ex.y[t], 1e-9) << t;
+  }
+}
+
+TEST(CompareScenario, TruthInSetMembershipParametrisationIsThePapers) {
+  const auto c = SetMembershipTruth(LoadScenario("setmembership-example").plant);
+  ASSERT_TRUE(c.ok) << c.reason;
+  const auto p = CeroneExample::TrueParameters();
+  ASSERT_EQ(c.theta.size(), p.size());
+  for (std::size_t k = 0; k < p.size(); ++k) EXPECT_NEAR(c.theta[k], p[k], 1e-12) << c.names[k];
+  // A rescaled plant (input map x2, inverse output x3) has the same normalised parameters.
+  auto s = LoadScenario("setmembership-example");
+  for (auto& v : s.plant.model.input.coefficients) v *= 2.0;
+  for (auto& v : s.plant.inverse_output) v *= 3.0;
+  for (auto& v : s.plant.model.linear.b) v *= 1.5;
+  const auto c2 = SetMembershipTruth(s.plant);
+  for (std::size_t k = 0; k < p.size(); ++k)
+    EXPECT_NEAR(c2.theta[k], c.names[k][0] == 'b' ? p[k] * 1.5 * 2.0 / 3.0 : p[k], 1e-12) << c.names[k];
+}
+
+TEST(CompareScenario, MethodsOutsideTheirClassAreReportedNotRun) {
+  const auto sm = LoadScenario("setmembership-example");
+  EXPECT_TRUE(MethodApplies(sm, "setmembership").applies);
+  EXPECT_TRUE(MethodApplies(sm, "esmaeilani").applies);
+  EXPECT_FALSE(MethodApplies(sm, "brouri").applies);
+  const auto br = LoadScenario("brouri-backlash");
+  EXPECT_TRUE(MethodApplies(br, "brouri").applies);
+  EXPECT_FALSE(MethodApplies(br, "setmembership").applies);
+  EXPECT_FALSE(MethodApplies(br, "esmaeilani").applies);
+  const auto va = LoadScenario("valve");
+  EXPECT_TRUE(MethodApplies(va, "esmaeilani").applies);
+  EXPECT_FALSE(MethodApplies(va, "setmembership").applies);
+  EXPECT_FALSE(MethodApplies(va, "brouri").applies);
+  const auto j = RunOne(sm, {"brouri"}, 0, 1);
+  EXPECT_FALSE(j["methods"]["brouri"]["applicable"].get<bool>());
+  EXPECT_FALSE(j["methods"]["brouri"].contains("seconds"));  // not run
+  EXPECT_NE(j["methods"]["brouri"]["reason"].get<std::string>().find("backlash"), std::string::npos);
+}
+
+TEST(CompareScenario, BadScenarioFilesAreClearErrors) {
+  const std::string dir = ::testing::TempDir() + "/compare_bad";
+  fs::create_directories(dir);
+  auto expect_error = [&](const std::string& text, const std::string& needle) {
+    const std::string path = dir + "/s.json";
+    std::ofstream(path) << text;
+    try {
+      LoadScenario(path);
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "setmembrship": {}})", "setmembrship");
+  expect_error(R"({"name": "x", "plant": "hw"})", "model");
+  expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "noise": {"std": 1}})", "bounded");
+  expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "setmembership": {"horizon": 3}})",
+               "minimal order");
+  expect_error("{not json", "not valid JSON");
+  EXPECT_THROW(LoadScenario(dir + "/missing.json"), InputError);
+  // The truth outside the prior box is an assumption violation, reported as a failed run with the reason.
+  auto s = LoadScenario("setmembership-example");
+  s.setmembership.box_half_width = 1.0;  // alpha3 = 3.2 lies outside
+  s.setmembership.samples = 20;
+  const auto j = RunOne(s, {"setmembership"}, 0, 1);
+  EXPECT_EQ(j["methods"]["setmembership"]["status"], "failed");
+  EXPECT_NE(j["methods"]["setmembership"]["message"].get<std::string>().find("outside the prior box"), std::string::npos);
+}
+
+// Recomputes mean / std / worst from the per-run files.
+std::map<std::string, std::vector<double>> Values(const std::vector<json>& runs, const std::string& method) {
+  std::map<std::string, std::vector<double>> v;
+  for (const auto& r : runs) {
+    const auto& m = r["methods"][method];
+    if (m.value("status", "") != "ok") continue;
+    for (const auto& [q, x] : m["quantities"].items()) v[q].push_back(x.get<double>());
+  }
+  return v;
+}
+
+TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth) {
+  auto s = LoadScenario("setmembership-example");
+  s.setmembership.samples = 40;  // n = 1, delta = 1: seconds per run
+  s.esmaeilani.samples = 150;
+  s.validation.samples = 200;
+  StudyOptions o;
+  o.runs = 3;
+  o.seed = 11;
+  o.jobs = 2;
+  o.quiet = true;
+  o.out_dir = ::testing::TempDir() + "/compare_small";
+  fs::remove_all(o.out_dir);
+  const auto r = RunStudy(o, s);
+  EXPECT_EQ(r.runs_computed, 3);
+  for (const char* f : {"summary.md", "summary.json", "scenario.json", "plots/plots.gp"})
+    EXPECT_TRUE(fs::exists(o.out_dir + "/" + f)) << f;
+  const json summary = ReadJson(o.out_dir + "/summary.json");
+  std::vector<json> runs;
+  for (int k = 0; k < o.runs; ++k) runs.push_back(ReadJson(fmt::format("{}/runs/run_{:04d}.json", o.out_dir, k)));
+
+  // Every applicable method ran in every run; brouri was reported, not run.
+  EXPECT_TRUE(summary["all_ok"].get<bool>()) << summary["methods"].dump(1);
+  EXPECT_FALSE(summary["methods"]["brouri"]["applicable"].get<bool>());
+
+  // Coverage: every guaranteed interval of every run contains the truth (checked on the files themselves).
+  int intervals = 0;
+  for (const auto& run : runs) {
+    const auto& sm = run["methods"]["setmembership"];
+    ASSERT_EQ(sm["status"], "ok") << sm.dump(1);
+    const auto truth = CeroneExample::TrueParameters();
+    ASSERT_EQ(sm["intervals"].size(), truth.size());
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      const auto& iv = sm["intervals"][k];
+      EXPECT_LE(iv["lower"].get<double>(), truth[k] + 1e-6 * (1 + std::abs(truth[k]))) << iv.dump();
+      EXPECT_GE(iv["upper"].get<double>(), truth[k] - 1e-6 * (1 + std::abs(truth[k]))) << iv.dump();
+      EXPECT_TRUE(iv["covered"].get<bool>()) << iv.dump();
+      ++intervals;
+    }
+  }
+  EXPECT_TRUE(r.coverage_ok);
+  EXPECT_EQ(summary["methods"]["setmembership"]["coverage"]["covered"].get<int>(), intervals);
+  EXPECT_EQ(summary["methods"]["setmembership"]["coverage"]["total"].get<int>(), intervals);
+
+  // The tables: summary.json and the numbers printed in summary.md equal statistics recomputed here.
+  std::ifstream md_in(o.out_dir + "/summary.md");
+  std::stringstream md;
+  md << md_in.rdbuf();
+  int checked = 0;
+  for (const std::string method : {"setmembership", "esmaeilani"}) {
+    const auto values = Values(runs, method);
+    ASSERT_FALSE(values.empty()) << method;
+    for (const auto& [q, v] : values) {
+      double mean = 0.0;
+      for (double x : v) mean += x / v.size();
+      double ss = 0.0;
+      for (double x : v) ss += (x - mean) * (x - mean);
+      const double sd = v.size() > 1 ? std::sqrt(ss / (v.size() - 1)) : 0.0;
+      const double worst = q == "fit_pct" ? *std::min_element(v.begin(), v.end()) : *std::max_element(v.begin(), v.end());
+      const auto& st = summary["methods"][method]["quantities"][q];
+      EXPECT_EQ(st["n"].get<std::size_t>(), v.size()) << method << " " << q;
+      EXPECT_NEAR(st["mean"].get<double>(), mean, 1e-12 * (1 + std::abs(mean))) << method << " " << q;
+      EXPECT_NEAR(st["std"].get<double>(), sd, 1e-12 * (1 + sd)) << method << " " << q;
+      EXPECT_EQ(st["worst"].get<double>(), worst) << method << " " << q;
+      const std::string row_tail =
+          fmt::format(" | {} | {:.4g} | {:.4g} | {:.4g} |", v.size(), mean, sd, worst);
+      EXPECT_NE(md.str().find("| " + method + " | "), std::string::npos);
+      EXPECT_NE(md.str().find(row_tail), std::string::npos) << method << " " << q << " row tail " << row_tail;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 8);
+  // Time per method equals the per-run times.
+  double total = 0.0;
+  for (const auto& run : runs) total += run["methods"]["esmaeilani"]["seconds"].get<double>();
+  EXPECT_NEAR(summary["methods"]["esmaeilani"]["time"]["total"].get<double>(), total, 1e-9);
+  // Point estimates mapped into the set-membership parametrisation were checked for every parameter.
+  EXPECT_EQ(summary["methods"]["esmaeilani"]["inside_setmembership_intervals"].size(), 8u);
+
+  // Resume: the same study again computes nothing and reports the same tables.
+  const auto r2 = RunStudy(o, s);
+  EXPECT_EQ(r2.runs_computed, 0);
+  EXPECT_EQ(r2.runs_resumed, 3);
+  EXPECT_EQ(r2.summary["methods"].dump(), summary["methods"].dump());
+}
+
+}  // namespace
+}  // namespace hw::compare
