@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <CGAL/Interval_nt.h>
+#include <Eigen/Sparse>
 #include <fmt/format.h>
 
 namespace hw::sdp {
@@ -141,6 +142,48 @@ VerifiedBound Verify(const LmiProblem& problem, const std::vector<Eigen::MatrixX
   return done("");
 }
 
+// Least-squares repair of the equalities F_i . X = c_i (floating point; the result is verified like any X):
+// X + sum_k mu_k F_k with G mu = r, G_ik = F_i . F_k, the smallest change in the trace norm. Interior-point
+// multipliers are safely inside the cone, so the tiny change keeps them PSD while the residuals (which the
+// a-priori bounds multiply) drop to rounding level. Empty on failure.
+std::vector<Eigen::MatrixXd> ProjectOntoEqualities(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X) {
+  const int m = problem.num_vars();
+  const int nb = static_cast<int>(problem.blocks.size());
+  std::vector<long> offset(nb + 1, 0);
+  for (int b = 0; b < nb; ++b) offset[b + 1] = offset[b] + static_cast<long>(problem.blocks[b].size) * problem.blocks[b].size;
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(problem.nonzeros());
+  Eigen::VectorXd r(m);
+  for (int i = 1; i <= m; ++i) {
+    double fx = 0.0;
+    for (const auto& e : problem.F[i]) {
+      const double w = e.row == e.col ? 1.0 : 2.0;
+      fx += w * e.value * X[e.block](e.row, e.col);
+      t.emplace_back(i - 1, offset[e.block] + static_cast<long>(e.row) * problem.blocks[e.block].size + e.col,
+                     std::sqrt(w) * e.value);
+    }
+    r[i - 1] = problem.c[i - 1] - fx;
+  }
+  Eigen::SparseMatrix<double> A(m, offset[nb]);
+  A.setFromTriplets(t.begin(), t.end());
+  Eigen::SparseMatrix<double> G = A * A.transpose();
+  double top = 0.0;
+  for (int i = 0; i < m; ++i) top = std::max(top, G.coeff(i, i));
+  if (!(top > 0)) return {};
+  for (int i = 0; i < m; ++i) G.coeffRef(i, i) += 1e-14 * top;  // variables without F_i stay solvable
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(G);
+  if (ldlt.info() != Eigen::Success) return {};
+  const Eigen::VectorXd mu = ldlt.solve(r);
+  if (ldlt.info() != Eigen::Success || !mu.allFinite()) return {};
+  std::vector<Eigen::MatrixXd> out = X;
+  for (int i = 1; i <= m; ++i)
+    for (const auto& e : problem.F[i]) {
+      out[e.block](e.row, e.col) += mu[i - 1] * e.value;
+      if (e.row != e.col) out[e.block](e.col, e.row) += mu[i - 1] * e.value;
+    }
+  return out;
+}
+
 double max_abs(const std::vector<Eigen::MatrixXd>& X) {
   double s = 0.0;
   for (const auto& B : X)
@@ -251,8 +294,23 @@ VerifiedBound VerifyOptimalSolve(const VerifyOptions& options, const SdpOptions&
   auto acceptable = [&](const VerifiedBound& v) {
     return v.verified() && v.correction <= options.acceptable_correction * std::max(1.0, std::abs(fb));
   };
+  // Cheap first remedy for residual-dominated corrections: project X onto the equalities (no re-solve).
+  if (!acceptable(best) && summary.X.size() == problem.blocks.size()) {
+    const auto P = ProjectOntoEqualities(problem, summary.X);
+    if (!P.empty()) {
+      VerifiedBound v = VerifyLowerBound(problem, P, bounds, fb);
+      if (v.verified() && (!best.verified() || v.bound > best.bound)) {
+        v.message += " [multiplier projected onto the equalities]";
+        best = v;
+      }
+    }
+  }
+  // Re-solves only help when the multiplier is not safely PSD: unverified, or the eigenvalue term dominates.
+  auto resolve_helps = [&](const VerifiedBound& v) {
+    return !v.verified() || (!acceptable(v) && -v.eigenvalue_term > 0.5 * v.correction);
+  };
   const double xscale = std::max(1.0, max_abs(summary.X));
-  for (int k = 0; k < options.max_resolves && !acceptable(best) && !summary.X.empty(); ++k) {
+  for (int k = 0; k < options.max_resolves && resolve_helps(best) && !summary.X.empty(); ++k) {
     const double eps = options.perturbation * std::pow(10.0, k) * xscale;
     LmiProblem perturbed = problem;
     for (int i = 1; i <= problem.num_vars(); ++i)
@@ -268,6 +326,10 @@ VerifiedBound VerifyOptimalSolve(const VerifyOptions& options, const SdpOptions&
     std::vector<Eigen::MatrixXd> X = s.X;
     for (auto& B : X) B.diagonal().array() += eps;
     VerifiedBound v = VerifyLowerBound(problem, X, bounds, fb);
+    if (const auto P = ProjectOntoEqualities(problem, X); !P.empty()) {
+      const VerifiedBound vp = VerifyLowerBound(problem, P, bounds, fb);
+      if (vp.verified() && (!v.verified() || vp.bound > v.bound)) v = vp;
+    }
     if (v.verified() && (!best.verified() || v.bound > best.bound)) {
       v.resolves = best.resolves;
       v.resolve_seconds = best.resolve_seconds;

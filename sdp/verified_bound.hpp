@@ -35,8 +35,10 @@ struct VariableBounds {
 
 struct VerifyOptions {
   bool enabled = true;
-  // A verified bound looser than the floating-point bound by more than this (relative to max(1, |bound|))
-  // triggers perturbed re-solves (X >= eps I, VSDP's remedy for multipliers that are not safely PSD).
+  // A verified bound looser than the floating-point bound by more than this (relative to max(1, |bound|)) is
+  // repaired: first X is projected onto the equalities (cheap); then, when the bound is still unverified or
+  // the eigenvalue term dominates, perturbed re-solves (X >= eps I, VSDP's remedy for multipliers that are
+  // not safely PSD). A re-solve costs a full SDP solve.
   double acceptable_correction = 1e-7;
   int max_resolves = 2;
   double perturbation = 1e-8;  // eps of the first re-solve, relative to max(1, max |X_ij|); x10 per retry
@@ -77,10 +79,11 @@ VerifiedBound VerifyLowerBound(const LmiProblem& problem, const std::vector<Eige
 VerifiedBound VerifyInfeasibility(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X,
                                   const VariableBounds& bounds);
 
-// Verifies an optimal solve; when that fails or the correction exceeds options.acceptable_correction, solves
+// Verifies an optimal solve; when the correction exceeds options.acceptable_correction, verifies X projected
+// onto the equalities F_i . X = c_i too; when still unverified (or the eigenvalue term dominates), solves
 // the perturbed problem min (c - eps tr F)^T y (whose multiplier X' gives X = X' + eps I >= eps I with the
-// same equalities) up to max_resolves times and keeps the best verified bound. `summary` must be optimal
-// and hold X.
+// same equalities) up to max_resolves times. Keeps the best verified bound. `summary` must be optimal and
+// hold X.
 VerifiedBound VerifyOptimalSolve(const VerifyOptions& options, const SdpOptions& sdp_options, const LmiProblem& problem,
                                  const VariableBounds& bounds, const SdpSummary& summary, SdpSolver& solver);
 
