@@ -46,9 +46,14 @@ double InfeasibilityResidual(const LmiProblem& problem, const std::vector<Eigen:
   if (X.size() != problem.blocks.size()) return inf;
   double scale = 0.0;
   for (const auto& B : X) scale = std::max(scale, B.cwiseAbs().maxCoeff());
-  for (const auto& B : X) {
+  for (std::size_t b = 0; b < X.size(); ++b) {
+    const auto& B = X[b];
     if (B.rows() == 0) continue;
-    const double lmin = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(B, Eigen::EigenvaluesOnly).eigenvalues()(0);
+    // Diagonal (LP) blocks are stored as square matrices; their eigenvalues are the diagonal (an eigen-solve of
+    // a 4000-row LP block took minutes).
+    const double lmin = problem.blocks[b].kind == BlockSpec::Kind::kDiagonal
+                            ? B.diagonal().minCoeff()
+                            : Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(B, Eigen::EigenvaluesOnly).eigenvalues()(0);
     if (lmin < -1e-10 * std::max(scale, 1e-300)) return inf;
   }
   auto inner = [&](const std::vector<Entry>& F) {
@@ -96,7 +101,9 @@ double UnboundednessResidual(const LmiProblem& problem, const std::vector<double
           S(e.row, e.col) += e.value * d[i - 1] / norm;
           if (e.row != e.col) S(e.col, e.row) += e.value * d[i - 1] / norm;
         }
-    worst = std::min(worst, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S, Eigen::EigenvaluesOnly).eigenvalues()(0));
+    worst = std::min(worst, problem.blocks[b].kind == BlockSpec::Kind::kDiagonal
+                                ? S.diagonal().minCoeff()
+                                : Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S, Eigen::EigenvaluesOnly).eigenvalues()(0));
   }
   return -worst / -cd;
 }
