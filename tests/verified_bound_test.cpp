@@ -160,6 +160,32 @@ TEST(VerifiedBound, PerturbedMultiplierGivesLooserButValidBound) {
   for (auto& B : X) B *= 1.5;
   const auto v = sdp::VerifyLowerBound(r.lmi(), X, s.bounds, s.sdp.lower_bound);
   EXPECT_TRUE(!v.verified() || v.bound <= -std::sqrt(0.5)) << v.message;
+  // The repairs: residual damage (X scaled by 1 + 1e-5) is undone by the projection onto the equalities without
+  // a re-solve; indefinite damage (1e-5 noise) needs the perturbed re-solve. Both end verified, valid and close.
+  auto solver = sdp::MakeSolver("sdpa");
+  sdp::SdpSummary scaled = s.sdp;
+  for (auto& B : scaled.X) B *= 1.0 + 1e-5;
+  const auto ws = sdp::VerifyOptimalSolve({}, {}, r.lmi(), s.bounds, scaled, *solver);
+  ASSERT_TRUE(ws.verified()) << ws.message;
+  EXPECT_EQ(ws.resolves, 0) << ws.message;
+  EXPECT_LE(ws.bound, -std::sqrt(0.5));
+  // The projected X is dual feasible to rounding, so what remains is its own (lower) objective: F_0 . X moved by
+  // about 1e-5 * |F_0 . X| = 7e-6, and the projection never does worse than the damaged X as it is.
+  EXPECT_LT(ws.correction, 1e-5) << ws.message;
+  EXPECT_LE(ws.residual_term, 0.0);
+  EXPECT_GT(ws.residual_term, -1e-12) << ws.message;
+  const auto raw = sdp::VerifyLowerBound(r.lmi(), scaled.X, s.bounds, s.sdp.lower_bound);
+  EXPECT_GE(ws.bound, raw.bound);
+  sdp::SdpSummary noisy = s.sdp;
+  for (auto& B : noisy.X) {
+    Eigen::MatrixXd P(B.rows(), B.cols());
+    for (Eigen::Index i = 0; i < P.size(); ++i) P.data()[i] = N(rng);
+    B += 1e-5 * (P + P.transpose()) / 2;
+  }
+  const auto wn = sdp::VerifyOptimalSolve({}, {}, r.lmi(), s.bounds, noisy, *solver);
+  ASSERT_TRUE(wn.verified()) << wn.message;
+  EXPECT_LE(wn.bound, -std::sqrt(0.5));
+  EXPECT_LT(wn.correction, 1e-6) << wn.message;
   // Without a-priori bounds on the variables, nonzero residuals cannot be bounded: unverified.
   const auto none = sdp::VariableBounds::Uniform(r.lmi().num_vars(), -INFINITY, INFINITY);
   EXPECT_FALSE(sdp::VerifyLowerBound(r.lmi(), s.sdp.X, none, s.sdp.lower_bound).verified());
