@@ -21,9 +21,9 @@ void AddEsmaeilaniCommand(CLI::App& app) {
   struct Opts {
     std::vector<std::string> data, validate;
     std::string constraints, out = "esmaeilani_model.json", u_col = "u", y_col = "y";
-    int order = 3, grid_f = 12, grid_g = 12, max_iterations = 100;
+    int order = 3, grid_f = 12, grid_g = 12, max_iterations = 100, oe_max_iterations = 100;
     double weight_state = 1.0, weight_output = 1.0, weight_noise = 1.0;
-    bool no_clamp = false;
+    bool no_clamp = false, refine_oe = false, oe_estimate_x0 = false;
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--data", o->data, "CSV segments used for estimation (columns u,y; one segment per file)")
@@ -44,6 +44,13 @@ void AddEsmaeilaniCommand(CLI::App& app) {
   cmd->add_option("--weight-output", o->weight_output, "weight of the output-equation residual e (paper: 1)");
   cmd->add_option("--weight-noise", o->weight_noise, "weight of the input-noise term v = eta + eps_f (paper: 1)");
   cmd->add_flag("--no-clamp", o->no_clamp, "extrapolate g linearly instead of holding it outside the identified range");
+  cmd->add_flag("--refine-oe", o->refine_oe,
+                "after the paper's SQP, minimise the simulation (output) error of the estimation segments under the "
+                "same constraints (Levenberg-Marquardt, one QP per step; not in the paper)");
+  cmd->add_option("--oe-max-iterations", o->oe_max_iterations, "iteration limit of the output-error refinement");
+  cmd->add_flag("--oe-estimate-initial-states", o->oe_estimate_x0,
+                "output-error refinement: estimate each segment's initial state instead of starting it at the model's "
+                "steady state at its first input (the default, as in the validation)");
   cmd->add_option("--out", o->out, "model JSON to write");
   cmd->callback([o] {
     auto load = [&](const std::string& path) {
@@ -67,6 +74,9 @@ void AddEsmaeilaniCommand(CLI::App& app) {
     opt.weight_output = o->weight_output;
     opt.weight_noise = o->weight_noise;
     opt.clamp_output = !o->no_clamp;
+    opt.refine_output_error = o->refine_oe;
+    opt.oe_max_iterations = o->oe_max_iterations;
+    opt.oe_estimate_initial_states = o->oe_estimate_x0;
     std::string err;
     if (!opt.IsValid(&err)) throw InputError(err);
     esmaeilani::Summary sum;
@@ -75,6 +85,12 @@ void AddEsmaeilaniCommand(CLI::App& app) {
     fmt::print("{} ({} iterations, cost {:.6g} -> {:.6g}, {:.2f} s of which QP {:.2f} s; {} unknowns, {} equations, "
                "{} constraints)\n", sum.message, sum.iterations, sum.initial_cost, sum.final_cost, sum.seconds,
                sum.qp_seconds, sum.unknowns, sum.equations, sum.constraints);
+    if (sum.output_error.ran)
+      fmt::print("output-error refinement: {} ({} iterations, simulation error {:.6g} -> {:.6g}, {:.2f} s of which QP "
+                 "{:.2f} s; {} parameters, max constraint violation {:.2g})\n", sum.output_error.message,
+                 sum.output_error.iterations, sum.output_error.initial_cost, sum.output_error.final_cost,
+                 sum.output_error.seconds, sum.output_error.qp_seconds, sum.output_error.parameters,
+                 sum.output_error.max_constraint_violation);
     fmt::print("paper parametrisation: a = [{:.6g}], b = [{:.6g}], d = {:.6g}, m_e = {:.6g}\n", fmt::join(m.a, ", "),
                fmt::join(m.b, ", "), m.d, m.output_offset);
     fmt::print("f pairs (u', f'):\n");
@@ -87,6 +103,7 @@ void AddEsmaeilaniCommand(CLI::App& app) {
     j["esmaeilani"] = m.ToJson();
     j["esmaeilani"]["constraints"] = cons.ToJson();
     j["esmaeilani"]["final_cost"] = sum.final_cost;
+    if (sum.output_error.ran) j["esmaeilani"]["output_error_cost"] = sum.output_error.final_cost;
     write_text_atomic(o->out, j.dump(2) + "\n");
     fmt::print("project model: a = [{:.6g}], b = [{:.6g}], delay {}; wrote {}\n", fmt::join(model.linear.a, ", "),
                fmt::join(model.linear.b, ", "), model.linear.delay, o->out);

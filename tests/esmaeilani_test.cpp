@@ -1,6 +1,7 @@
 // Tests of the Esmaeilani estimator (paper 002): exact recovery on noise-free data, constraints held,
 // clear errors for unusable input, and the mapping to the project's model JSON.
 #include <cmath>
+#include <iostream>
 #include <random>
 #include <cstdlib>
 
@@ -9,6 +10,7 @@
 #include "core/csv_table.hpp"
 #include "core/hw_model.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
+#include "estimators/esmaeilani/valve_case.hpp"
 
 using namespace hw;
 using namespace hw::esmaeilani;
@@ -331,3 +333,90 @@ TEST(Esmaeilani, IpoptAndCgalSolveTheSameQp) {
 }
 
 }  // namespace
+
+// Output-error refinement on a low-noise valve rebuild: it must not worsen the simulation error of the
+// estimation data (it only accepts decreasing steps), must keep every known-information constraint, must
+// report the simulation error it reached (checked by an independent simulation here), and on held-out
+// data it should not be worse than the SQP estimate it started from.
+TEST(Esmaeilani, OutputErrorRefinementKeepsConstraintsAndDoesNotWorsenTheFit) {
+  ValveCase valve;
+  valve.output_noise_std = 0.05;
+  valve.input_noise_std = 0.01;
+  std::vector<Segment> est;
+  for (unsigned k = 0; k < 9; ++k) est.push_back(valve.ClosingOperation(1000 + k, 150));
+  const Segment val = valve.ClosingOperation(1009, 150);
+  const Constraints cons = valve.KnownInformation();
+  Options opt;
+  opt.order = 3;
+  opt.grid_f = 12;
+  opt.grid_g = 12;
+  opt.weight_state = 100;  // noise-scaled weights as in docs/esmaeilani.md
+  opt.weight_output = 3;
+  opt.weight_noise = 20;
+  opt.max_iterations = 25;
+  Summary sum;
+  const EsmaeilaniModel sqp = Estimate(opt, est, cons, &sum);
+  ASSERT_TRUE(sum.ok()) << sum.message;
+  EXPECT_FALSE(sum.output_error.ran);  // off by default: the paper's estimator
+  OutputErrorSummary oes;
+  const EsmaeilaniModel m = RefineOutputError(opt, est, cons, sqp, &oes);
+  ASSERT_TRUE(oes.ran);
+  EXPECT_GT(oes.iterations, 0) << oes.message;
+  EXPECT_EQ(oes.parameters, 12 + 12 + 3 + 3 + 2);  // steady-state starts: no initial-state unknowns
+  auto sim_error = [&](const EsmaeilaniModel& mm) {
+    double c = 0.0;
+    for (const auto& s : est) {
+      const auto yh = mm.Simulate(s.u);
+      for (std::size_t t = 0; t < yh.size(); ++t) c += (s.y[t] - yh[t]) * (s.y[t] - yh[t]);
+    }
+    return c;
+  };
+  EXPECT_NEAR(oes.initial_cost, sim_error(sqp), 1e-9 * oes.initial_cost);
+  EXPECT_NEAR(oes.final_cost, sim_error(m), 1e-9 * oes.initial_cost);
+  EXPECT_LE(oes.final_cost, oes.initial_cost);
+  // Known information still holds (same rows as the SQP: ranges, slopes, points, d = 0).
+  const double tol = 1e-6;
+  EXPECT_LE(oes.max_constraint_violation, tol);
+  EXPECT_EQ(m.d, 0.0);
+  for (std::size_t k = 0; k < m.f_values.size(); ++k) {
+    EXPECT_GE(m.f_values[k], 0.0 - tol);
+    EXPECT_LE(m.f_values[k], 100.0 + tol);
+    if (k + 1 < m.f_values.size()) {
+      const double s = (m.f_values[k + 1] - m.f_values[k]) / (m.u_grid[k + 1] - m.u_grid[k]);
+      EXPECT_GE(s, -tol);
+      EXPECT_LE(s, 5.0 + tol);
+    }
+  }
+  for (std::size_t k = 0; k + 1 < m.ginv_values.size(); ++k)
+    EXPECT_GE(m.ginv_values[k + 1] - m.ginv_values[k], -tol);
+  for (const auto& p : cons.f.points) EXPECT_NEAR(m.F(p.at), p.lower, tol);
+  for (const auto& p : cons.g_inverse.points) EXPECT_NEAR(m.Ginv(p.at), p.lower, tol);
+  // Held-out operation (steady-state start, as in the validation of docs/esmaeilani.md).
+  const double fit_sqp = fit_percent(val.y, sqp.Simulate(val.u)), fit_oe = fit_percent(val.y, m.Simulate(val.u));
+  std::cout << "held-out fit: SQP " << fit_sqp << " %, refined " << fit_oe << " %; simulation error " << oes.initial_cost
+            << " -> " << oes.final_cost << "\n";
+  EXPECT_GE(fit_oe, fit_sqp - 0.5) << "SQP " << fit_sqp << " %, refined " << fit_oe << " %";
+  EXPECT_GT(fit_oe, 97.0) << "SQP " << fit_sqp << " %, refined " << fit_oe << " %";
+}
+
+TEST(Esmaeilani, OutputErrorRefinementIsAnOptionOfEstimate) {
+  ValveCase valve;
+  std::vector<Segment> est;
+  for (unsigned k = 0; k < 3; ++k) est.push_back(valve.ClosingOperation(2000 + k, 80));
+  Options opt;
+  opt.max_iterations = 3;
+  opt.refine_output_error = true;
+  opt.oe_max_iterations = 5;
+  opt.oe_estimate_initial_states = true;
+  Summary sum;
+  const EsmaeilaniModel m = Estimate(opt, est, valve.KnownInformation(), &sum);
+  ASSERT_TRUE(sum.ok()) << sum.message;
+  ASSERT_TRUE(sum.output_error.ran);
+  EXPECT_EQ(sum.output_error.parameters, 12 + 12 + 3 + 3 + 2 + 3 * 3);
+  EXPECT_LE(sum.output_error.final_cost, sum.output_error.initial_cost);
+  EXPECT_LE(sum.output_error.iterations, 5);
+  ASSERT_EQ(m.initial_states.size(), 3u);
+  opt.oe_max_iterations = 0;
+  std::string err;
+  EXPECT_FALSE(opt.IsValid(&err));
+}

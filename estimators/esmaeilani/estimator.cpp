@@ -353,6 +353,7 @@ bool Options::IsValid(std::string* error) const {
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(relative_decrease > 0)) return fail("relative_decrease must be > 0");
   if (!(damping >= 0)) return fail("damping must be >= 0");
+  if (oe_max_iterations < 1) return fail("oe_max_iterations must be >= 1");
   return true;
 }
 
@@ -751,7 +752,194 @@ EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& seg
     m.initial_states.push_back(x0);
   }
   sum.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (options.refine_output_error && sum.ok()) return RefineOutputError(options, segments, constraints, m, &sum.output_error);
   return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+EsmaeilaniModel RefineOutputError(const Options& options, const std::vector<Segment>& segments,
+                                  const Constraints& constraints, const EsmaeilaniModel& start,
+                                  OutputErrorSummary* summary) {
+  const auto t_start = Clock::now();
+  OutputErrorSummary local;
+  OutputErrorSummary& sum = summary ? *summary : local;
+  sum = OutputErrorSummary{};
+  sum.ran = true;
+  std::string err;
+  if (!options.IsValid(&err)) throw InputError("esmaeilani options: " + err);
+  const int n = static_cast<int>(start.a.size());
+  const int gf = static_cast<int>(start.f_values.size()), gg = static_cast<int>(start.ginv_values.size());
+  const int S = static_cast<int>(segments.size());
+  if (n < 1 || static_cast<int>(start.b.size()) != n || gf < 2 || gg < 2 ||
+      static_cast<int>(start.u_grid.size()) != gf || static_cast<int>(start.y_grid.size()) != gg)
+    throw InputError("output-error refinement: the start model is incomplete (needs a, b, f and g^-1 pairs)");
+  const bool est_x0 = options.oe_estimate_initial_states;
+  // theta = [f'; g'; a; b; d; m_e; x0 of each segment]
+  const int iF = 0, iG = gf, iA = gf + gg, iB = iA + n, iD = iB + n, iM = iD + 1, iX = iM + 1;
+  const int P = iX + (est_x0 ? S * n : 0);
+  int N = 0;
+  for (const auto& s : segments) {
+    if (s.u.size() != s.y.size() || s.u.empty())
+      throw InputError(fmt::format("output-error refinement: segment '{}' has {} inputs and {} outputs", s.name,
+                                   s.u.size(), s.y.size()));
+    N += static_cast<int>(s.u.size());
+  }
+  sum.parameters = P;
+  sum.residuals = N;
+
+  Eigen::VectorXd th(P);
+  for (int k = 0; k < gf; ++k) th[iF + k] = start.f_values[k];
+  for (int k = 0; k < gg; ++k) th[iG + k] = start.ginv_values[k];
+  for (int i = 0; i < n; ++i) th[iA + i] = start.a[i], th[iB + i] = start.b[i];
+  th[iD] = constraints.fix_d_zero ? 0.0 : start.d;
+  th[iM] = start.output_offset;
+  if (est_x0)
+    for (int s = 0; s < S; ++s) {
+      // The SQP's identified x_1 if it has one for this segment, else the steady state at the first input.
+      const std::vector<double> x0 = static_cast<int>(start.initial_states.size()) == S &&
+                                             static_cast<int>(start.initial_states[s].size()) == n
+                                         ? start.initial_states[s]
+                                         : start.SteadyState(segments[s].u.front());
+      for (int i = 0; i < n; ++i) th[iX + s * n + i] = x0[i];
+    }
+  auto unpack = [&](const Eigen::VectorXd& p) {
+    EsmaeilaniModel m = start;
+    for (int k = 0; k < gf; ++k) m.f_values[k] = p[iF + k];
+    for (int k = 0; k < gg; ++k) m.ginv_values[k] = p[iG + k];
+    for (int i = 0; i < n; ++i) m.a[i] = p[iA + i], m.b[i] = p[iB + i];
+    m.d = p[iD];
+    m.output_offset = p[iM];
+    m.initial_states.assign(S, std::vector<double>(n, 0.0));
+    for (int s = 0; s < S; ++s) {
+      if (!est_x0) {
+        m.initial_states[s] = m.SteadyState(segments[s].u.front());
+        continue;
+      }
+      for (int i = 0; i < n; ++i) m.initial_states[s][i] = p[iX + s * n + i];
+    }
+    return m;
+  };
+  // r = y - yhat, simulated exactly as the validation does (same Simulate, same output map).
+  auto residual = [&](const Eigen::VectorXd& p, Eigen::VectorXd* r) {
+    const EsmaeilaniModel m = unpack(p);
+    r->resize(N);
+    int row = 0;
+    for (int s = 0; s < S; ++s) {
+      const auto yh = m.Simulate(segments[s].u, est_x0 ? m.initial_states[s] : std::vector<double>{},
+                                 options.clamp_output);
+      for (std::size_t t = 0; t < yh.size(); ++t, ++row) (*r)[row] = segments[s].y[t] - yh[t];
+    }
+    ++sum.simulations;
+  };
+
+  // Known information: the SQP's rows on f' and g' (ranges, slopes, known points).
+  Triplets ct;
+  std::vector<double> lo, hi;
+  AddFunctionConstraints(constraints.f, start.u_grid, iF, &ct, &lo, &hi);
+  AddFunctionConstraints(constraints.g_inverse, start.y_grid, iG, &ct, &lo, &hi);
+  Eigen::SparseMatrix<double> C(static_cast<int>(lo.size()), P);
+  C.setFromTriplets(ct.begin(), ct.end());
+  const Eigen::VectorXd c_lo = Eigen::Map<Eigen::VectorXd>(lo.data(), lo.size());
+  const Eigen::VectorXd c_hi = Eigen::Map<Eigen::VectorXd>(hi.data(), hi.size());
+  auto violation = [&](const Eigen::VectorXd& p) {
+    const Eigen::VectorXd cp = C * p;
+    double v = 0.0;
+    for (int i = 0; i < cp.size(); ++i) v = std::max({v, c_lo[i] - cp[i], cp[i] - c_hi[i]});
+    return v;
+  };
+
+  Eigen::VectorXd r;
+  residual(th, &r);
+  double cost = r.squaredNorm();
+  sum.initial_cost = sum.final_cost = cost;
+  sum.cost_history.push_back(cost);
+  double lambda = 1e-3;  // Levenberg-Marquardt weight on the scaled diagonal
+  SparseQp qp;
+  qp.A = C;
+  sum.message = fmt::format("stopped after oe_max_iterations = {}", options.oe_max_iterations);
+  int it = 0;
+  for (it = 0; it < options.oe_max_iterations; ++it) {
+    // Forward-difference Jacobian of r (dense: few parameters, every residual depends on most of them).
+    Eigen::MatrixXd J(N, P);
+    for (int j = 0; j < P; ++j) {
+      if ((j == iD && constraints.fix_d_zero) || (j == iM && !options.estimate_output_offset)) {
+        J.col(j).setZero();
+        continue;
+      }
+      const double h = 1e-6 * std::max(1.0, std::abs(th[j]));
+      Eigen::VectorXd tp = th, rp;
+      tp[j] += h;
+      residual(tp, &rp);
+      J.col(j) = (rp - r) / h;
+    }
+    const Eigen::MatrixXd JtJ = J.transpose() * J;
+    const Eigen::VectorXd grad = J.transpose() * r;
+    // Marquardt scaling diag(J^T J), floored so that directions the data do not see (e.g. the initial
+    // state of an operation that starts deep in saturation) stay damped instead of free.
+    Eigen::VectorXd D = JtJ.diagonal();
+    const double floor = 1e-6 * std::max(D.maxCoeff(), 1e-300);
+    for (int j = 0; j < P; ++j) D[j] = std::max(D[j], floor);
+    qp.c = 2.0 * grad;
+    const Eigen::VectorXd cp = C * th;
+    qp.row_lower = c_lo - cp;
+    qp.row_upper = c_hi - cp;
+    for (int i = 0; i < qp.row_lower.size(); ++i) {
+      if (c_lo[i] <= -kInf) qp.row_lower[i] = -kInf;
+      if (c_hi[i] >= kInf) qp.row_upper[i] = kInf;
+    }
+    qp.var_lower = Eigen::VectorXd::Constant(P, -kInf);
+    qp.var_upper = Eigen::VectorXd::Constant(P, kInf);
+    if (constraints.fix_d_zero) qp.var_lower[iD] = qp.var_upper[iD] = -th[iD];
+    if (!options.estimate_output_offset) qp.var_lower[iM] = qp.var_upper[iM] = 0.0;
+    bool accepted = false, qp_failed = false;
+    double new_cost = cost;
+    Eigen::VectorXd new_r;
+    for (int tries = 0; tries < 12 && !accepted; ++tries) {
+      Eigen::MatrixXd H = JtJ;
+      H.diagonal() += lambda * D;
+      qp.H = (2.0 * H).sparseView();
+      Eigen::VectorXd step = Eigen::VectorXd::Zero(P);
+      const auto q0 = Clock::now();
+      const QpSummary qs = SolveQp(options.qp, qp, &step);
+      sum.qp_seconds += std::chrono::duration<double>(Clock::now() - q0).count();
+      ++sum.qp_solves;
+      if (!qs.solved) {
+        sum.message = "stopped: QP subproblem did not solve (" + qs.message + "); kept the last iterate";
+        qp_failed = true;
+        break;
+      }
+      residual(th + step, &new_r);
+      new_cost = new_r.squaredNorm();
+      if (new_cost < cost) {
+        th += step;
+        accepted = true;
+        lambda = std::max(lambda / 3.0, 1e-9);
+      } else {
+        lambda = std::min(lambda * 4.0, 1e10);
+      }
+    }
+    if (qp_failed) break;
+    if (!accepted) {
+      sum.message = "converged: no descent along the damped Gauss-Newton step";
+      break;
+    }
+    const double decrease = (cost - new_cost) / std::max(cost, 1e-300);
+    cost = new_cost;
+    r = new_r;
+    sum.cost_history.push_back(cost);
+    if (decrease < options.relative_decrease) {
+      sum.message = fmt::format("converged: relative decrease {:.3g} below {:.3g}", decrease,
+                                options.relative_decrease);
+      ++it;
+      break;
+    }
+  }
+  sum.iterations = it;
+  sum.final_cost = cost;
+  sum.improved = cost < sum.initial_cost;
+  sum.max_constraint_violation = violation(th);
+  sum.seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
+  return unpack(th);
 }
 
 }  // namespace hw::esmaeilani
