@@ -303,16 +303,19 @@ json RunBrouri(const Scenario& s, std::uint64_t seed) {
   const auto truth = s.backlash.Normalised();
   const auto tl = brouri::LinesOf(truth.kind, truth.backlash);
   const auto& el = r.nonlinear.lines;
-  const auto levels = cfg.steps.Levels();
-  const auto [lo, hi] = std::minmax_element(levels.begin(), levels.end());
-  const auto u = Linspace(*lo, *hi, 101);
+  // Each border is compared over the levels the experiment applies along it (beyond that it is extrapolation).
+  const auto range = [](const std::vector<double>& v) {
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    return Linspace(*lo, *hi, 101);
+  };
+  const auto u_up = range(cfg.steps.levels_up), u_down = range(cfg.steps.levels_down);
   std::vector<double> yt, ye, up, down;
-  for (double v : u) {
+  for (double v : u_up) {
     yt.push_back(brouri::PolyEval(truth.h, tl.slope_up * (v - tl.root_up)));
     ye.push_back(brouri::PolyEval(r.nonlinear.h, el.slope_up * (v - el.root_up)));
     up.push_back(ye.back());
   }
-  for (double v : u) {
+  for (double v : u_down) {
     yt.push_back(brouri::PolyEval(truth.h, tl.slope_down * (v - tl.root_down)));
     ye.push_back(brouri::PolyEval(r.nonlinear.h, el.slope_down * (v - el.root_down)));
     down.push_back(ye.back());
@@ -343,8 +346,8 @@ json RunBrouri(const Scenario& s, std::uint64_t seed) {
   q["phase_max_error_rad"] = pmx;
   out["not_available"]["fit_pct"] =
       "Brouri's method gives G at the tested frequencies only (no parametric G(s)), so there is no model to simulate";
-  out["curves"] = {{"static_u", u}, {"static_up", up}, {"static_down", down}, {"omega", om}, {"gain", gain},
-                   {"phase", phase}};
+  out["curves"] = {{"static_u_up", u_up}, {"static_up", up}, {"static_u_down", u_down}, {"static_down", down},
+                   {"omega", om}, {"gain", gain}, {"phase", phase}};
   out["estimate"] = {{"lines", {{"slope_up", el.slope_up}, {"root_up", el.root_up}, {"slope_down", el.slope_down},
                                 {"root_down", el.root_down}}},
                      {"h", r.nonlinear.h}};
@@ -409,20 +412,22 @@ nlohmann::json TruthCurves(const Scenario& s) {
   if (s.kind == PlantKind::kBacklash) {
     const auto truth = s.backlash.Normalised();
     const auto tl = brouri::LinesOf(truth.kind, truth.backlash);
-    const auto levels = brouri::WorkflowConfig::Paper().steps.Levels();
-    const auto [lo, hi] = std::minmax_element(levels.begin(), levels.end());
-    const auto u = Linspace(*lo, *hi, 101);
+    const auto steps = brouri::WorkflowConfig::Paper().steps;
+    const auto range = [](const std::vector<double>& v) {
+      const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+      return Linspace(*lo, *hi, 101);
+    };
+    const auto u_up = range(steps.levels_up), u_down = range(steps.levels_down);
     std::vector<double> up, down, om, gain;
-    for (double v : u) {
-      up.push_back(brouri::PolyEval(truth.h, tl.slope_up * (v - tl.root_up)));
-      down.push_back(brouri::PolyEval(truth.h, tl.slope_down * (v - tl.root_down)));
-    }
+    for (double v : u_up) up.push_back(brouri::PolyEval(truth.h, tl.slope_up * (v - tl.root_up)));
+    for (double v : u_down) down.push_back(brouri::PolyEval(truth.h, tl.slope_down * (v - tl.root_down)));
     for (int k = 0; k <= 200; ++k) {
       const double w = 0.005 * std::pow(100.0, k / 200.0);
       om.push_back(w);
       gain.push_back(std::abs(truth.g.Response(w) / truth.g.StaticGain()));
     }
-    return {{"static_u", u}, {"static_up", up}, {"static_down", down}, {"omega", om}, {"gain", gain}};
+    return {{"static_u_up", u_up}, {"static_up", up}, {"static_u_down", u_down}, {"static_down", down},
+            {"omega", om}, {"gain", gain}};
   }
   const auto u = Linspace(s.input_lo, s.input_hi, 101);
   std::vector<double> y, g;

@@ -114,7 +114,7 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
   std::vector<std::string> methods;
   for (const auto& [name, m] : summary["methods"].items())
     if (m.value("applicable", false)) methods.push_back(name);
-  std::string gp = "set terminal pngcairo size 900,600\nset grid\nset key outside right\n";
+  std::string gp = "set terminal pngcairo size 900,650\nset grid\nset key below\n";
   // 1. Error distributions: one panel per quantity, each method's runs as jittered points.
   for (const auto& q : QuantityOrder()) {
     std::string plot;
@@ -149,7 +149,8 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
       const std::string n = v["name"];
       auto it = std::find(names.begin(), names.end(), n);
       if (it == names.end()) it = names.insert(names.end(), n);
-      const double t = v["truth"], scale = std::max(std::abs(t), 0.1);
+      // Relative to the prior box half-width, so that every parameter's interval fits one scale.
+      const double t = v["truth"], scale = 0.5 * (v["box"][1].get<double>() - v["box"][0].get<double>());
       const double x = (it - names.begin()) + 1 + 0.6 * (run + 0.5) / runs.size() - 0.3;
       const double lo = (v["lower"].get<double>() - t) / scale, hi = (v["upper"].get<double>() - t) / scale;
       iv += fmt::format("{} {} {} {}\n", x, 0.5 * (lo + hi), lo, hi);
@@ -169,7 +170,7 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
       write_text_atomic(pd + "/point_estimates.dat", pts);
       plot += ", 'point_estimates.dat' using 1:2 with points pt 7 lc rgb '#d62728' title 'esmaeilani (mapped)'";
     }
-    gp += fmt::format("set output 'intervals.png'\nset title 'Intervals per run, (value - truth) / max(|truth|, 0.1)'\n"
+    gp += fmt::format("set output 'intervals.png'\nset title 'Intervals per run: (value - truth) / prior box half-width'\n"
                       "set xtics ({})\nplot {}\nset xtics auto\n", xt, plot);
   }
   // 3. Static curves and 4. normalised frequency responses overlaid (truth and every run's estimate).
@@ -182,8 +183,8 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
   const bool backlash = scenario.kind == PlantKind::kBacklash;
   std::string splot, fplot;
   if (backlash) {
-    curve_file("static_truth_up.dat", truth["static_u"], truth["static_up"]);
-    curve_file("static_truth_down.dat", truth["static_u"], truth["static_down"]);
+    curve_file("static_truth_up.dat", truth["static_u_up"], truth["static_up"]);
+    curve_file("static_truth_down.dat", truth["static_u_down"], truth["static_down"]);
     splot = "'static_truth_up.dat' with lines lw 3 lc rgb 'black' title 'truth (ascending border)', "
             "'static_truth_down.dat' with lines lw 3 dt 2 lc rgb 'black' title 'truth (descending border)'";
   } else {
@@ -203,11 +204,11 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
         for (std::size_t i = 0; i < c["static_u"].size(); ++i)
           sd += fmt::format("{} {}\n", c["static_u"][i].get<double>(), c["static_y"][i].get<double>());
       if (c.contains("static_up")) {
-        for (std::size_t i = 0; i < c["static_u"].size(); ++i)
-          sd += fmt::format("{} {}\n", c["static_u"][i].get<double>(), c["static_up"][i].get<double>());
+        for (std::size_t i = 0; i < c["static_u_up"].size(); ++i)
+          sd += fmt::format("{} {}\n", c["static_u_up"][i].get<double>(), c["static_up"][i].get<double>());
         sd += "\n";
-        for (std::size_t i = 0; i < c["static_u"].size(); ++i)
-          sd += fmt::format("{} {}\n", c["static_u"][i].get<double>(), c["static_down"][i].get<double>());
+        for (std::size_t i = 0; i < c["static_u_down"].size(); ++i)
+          sd += fmt::format("{} {}\n", c["static_u_down"][i].get<double>(), c["static_down"][i].get<double>());
       }
       sd += "\n";
       if (c.contains("omega"))
@@ -229,9 +230,9 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
   }
   gp += fmt::format("set output 'static_curves.png'\nset title 'Static input-output curve y_ss(u)'\n"
                     "set xlabel 'u'\nset ylabel 'y_ss'\nplot {}\n", splot);
-  gp += fmt::format("set output 'frequency_response.png'\nset title 'Normalised |G| (|G(e^(jw))|/|G(1)|{})'\n"
-                    "set xlabel 'omega [rad/{}]'\nset ylabel 'normalised gain'\n{}plot {}\n",
-                    backlash ? "; continuous |G(jw)|/|G(0)|" : "", backlash ? "s" : "sample",
+  gp += fmt::format("set output 'frequency_response.png'\nset title '{}'\n"
+                    "set xlabel 'omega [rad/{}]'\nset ylabel 'normalised gain (log scale)'\nset logscale y\n{}plot {}\n",
+                    backlash ? "Normalised |G(jw)|/|G(0)|" : "Normalised |G(e^{jw})|/|G(1)|", backlash ? "s" : "sample",
                     backlash ? "set logscale x\n" : "", fplot);
   write_text_atomic(pd + "/plots.gp", gp);
   const std::string cmd = fmt::format("cd '{}' && gnuplot plots.gp > gnuplot.log 2>&1", pd);
