@@ -6,6 +6,10 @@
 //    iterations. CGAL is run only at this size: at 179 unknowns 3 iterations already took 79 s (Ipopt
 //    0.14 s). Counters: qp_seconds, final_cost (the two must agree), and for CGAL ratio_to_ipopt
 //    (median QP time / Ipopt's median QP time in this run).
+// 3. BM_OutputErrorRefinement: the optional output-error refinement (10 Levenberg-Marquardt iterations,
+//    forward-difference Jacobian, one Ipopt QP per trial step) from a 10-iteration SQP estimate, valve
+//    case with 1..8 closing operations of 100 samples; second argument 1 = initial states estimated
+//    (3 more parameters per operation). Counters: parameters, iterations, qp_solves, qp_share.
 #include <algorithm>
 #include <map>
 #include <vector>
@@ -71,6 +75,31 @@ void BM_QpBackend(benchmark::State& state) {
 }
 BENCHMARK(BM_QpBackend)->ArgName("cgal")->Arg(0)->Arg(1)->Iterations(1)->Repetitions(3)
     ->Unit(benchmark::kMillisecond)->ReportAggregatesOnly(true);
+
+void BM_OutputErrorRefinement(benchmark::State& state) {
+  ValveCase valve;
+  std::vector<Segment> segs;
+  for (int k = 0; k < state.range(0); ++k) segs.push_back(valve.ClosingOperation(2000 + k, 100));
+  Options opt;
+  opt.max_iterations = 10;
+  const EsmaeilaniModel start = Estimate(opt, segs, valve.KnownInformation(), nullptr);
+  opt.oe_max_iterations = 10;
+  opt.oe_estimate_initial_states = state.range(1) == 1;
+  opt.relative_decrease = 1e-300;  // run the 10 iterations unless no descent is found
+  double qp = 0.0, total = 0.0;
+  OutputErrorSummary sum;
+  for (auto _ : state) {
+    RefineOutputError(opt, segs, valve.KnownInformation(), start, &sum);
+    qp += sum.qp_seconds;
+    total += sum.seconds;
+  }
+  state.counters["parameters"] = sum.parameters;
+  state.counters["iterations"] = sum.iterations;
+  state.counters["qp_solves"] = sum.qp_solves;  // trial steps (rejected ones included) of the last run
+  state.counters["qp_share"] = qp / total;
+}
+BENCHMARK(BM_OutputErrorRefinement)->ArgNames({"ops", "x0"})->ArgsProduct({{1, 2, 4, 8}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)->Repetitions(3)->ReportAggregatesOnly(true);
 
 }  // namespace
 
