@@ -324,6 +324,41 @@ SetMembershipClass SetMembershipTruth(const Plant& plant) {
   return c;
 }
 
+namespace {
+bool plant_inverse_ok(const Plant& p, double zlo, double zhi) {
+  const int n = 401;
+  double prev = 0.0, sign = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double z = zlo + (zhi - zlo) * i / (n - 1);
+    const auto w = p.output(z);
+    if (!w) return false;
+    if (i > 0) {
+      const double d = *w - prev;
+      // Flat pieces (saturation) are allowed; a change of direction is not.
+      if (sign == 0.0 && d != 0.0) sign = d > 0 ? 1.0 : -1.0;
+      if (d * sign < 0) return false;
+    }
+    prev = *w;
+  }
+  return true;
+}
+// Esmaeilani identifies g^-1 as ordered pairs: the output map must be monotone over the outputs the
+// experiments reach (checked on the z range of a random-level record of the input range).
+std::string OutputNotInvertible(const Scenario& s) {
+  const auto& m = s.plant.model;
+  std::vector<double> u(2000);
+  for (int t = 0; t < 2000; ++t) u[t] = s.input_lo + (s.input_hi - s.input_lo) * ((t / 7) * 7919 % 1000) / 999.0;
+  std::vector<double> x(u.size());
+  for (std::size_t t = 0; t < u.size(); ++t) x[t] = m.input(u[t]);
+  const auto z = m.linear.simulate(x);
+  const auto [zlo, zhi] = std::minmax_element(z.begin(), z.end());
+  if (!plant_inverse_ok(s.plant, *zlo, *zhi))
+    return "the output map is not monotone over the reachable outputs: Esmaeilani's ordered pairs of g^-1 "
+           "cannot represent it";
+  return "";
+}
+}  // namespace
+
 const std::vector<std::string>& AllMethods() {
   static const std::vector<std::string> m = {"setmembership", "brouri", "esmaeilani"};
   return m;
@@ -362,6 +397,8 @@ Applicability MethodApplies(const Scenario& s, const std::string& method) {
       a.applies = true;
       a.experiment = fmt::format("{} closing operations of {} samples (paper 002's valve case)", s.esmaeilani.segments,
                                  s.esmaeilani.samples);
+    } else if (const std::string why = OutputNotInvertible(s); !why.empty()) {
+      a.reason = why;
     } else {
       a.applies = true;
       a.experiment = fmt::format("{} operating records of {} samples (random levels held {}..{} samples)",

@@ -70,6 +70,18 @@ TEST(CompareScenario, MethodsOutsideTheirClassAreReportedNotRun) {
   EXPECT_TRUE(MethodApplies(va, "esmaeilani").applies);
   EXPECT_FALSE(MethodApplies(va, "setmembership").applies);
   EXPECT_FALSE(MethodApplies(va, "brouri").applies);
+  // A user plant whose output map folds back (w = z - z^3 over the reachable z) fits neither static-map method.
+  const auto folded = Scenario::FromJson(nlohmann::json::parse(R"({"name": "folded",
+      "model": {"input_nonlinearity": {"kind": "identity"}, "linear": {"a": [-0.5], "b": [0, 1]},
+                "output_nonlinearity": {"kind": "polynomial", "coefficients": [1, 0, -1]}},
+      "input_range": [-2, 2], "noise": {"bound": 0.01}})"), "folded.json");
+  EXPECT_FALSE(MethodApplies(folded, "esmaeilani").applies);
+  EXPECT_NE(MethodApplies(folded, "esmaeilani").reason.find("monotone"), std::string::npos);
+  EXPECT_FALSE(MethodApplies(folded, "setmembership").applies);
+  // The same plant with a monotone output map (w = z + z^3) fits Esmaeilani's class.
+  auto monotone = folded;
+  monotone.plant.model.output.coefficients = {1, 0, 1};
+  EXPECT_TRUE(MethodApplies(monotone, "esmaeilani").applies) << MethodApplies(monotone, "esmaeilani").reason;
   const auto j = RunOne(sm, {"brouri"}, 0, 1);
   EXPECT_FALSE(j["methods"]["brouri"]["applicable"].get<bool>());
   EXPECT_FALSE(j["methods"]["brouri"].contains("seconds"));  // not run
