@@ -133,9 +133,11 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
                           methods[k], methods[k]);
     }
     if (plot.empty()) continue;
+    std::string xt;
+    for (std::size_t k = 0; k < methods.size(); ++k) xt += fmt::format("{}'{}' {}", k ? ", " : "", methods[k], k + 1);
     gp += fmt::format("set output 'errors_{}.png'\nset title '{} ({} runs)'\nset xrange [0.5:{}.5]\n"
-                      "set xtics 1\nunset logscale\nplot {}\n",
-                      q, QuantityLabel(q), runs.size(), methods.size(), plot);
+                      "set xtics ({})\nunset logscale\nplot {}\n",
+                      q, QuantityLabel(q), runs.size(), methods.size(), xt, plot);
   }
   gp += "set autoscale x\nset xtics auto\n";
   // 2. Intervals with the truth and the point estimates, relative to the truth.
