@@ -1,0 +1,69 @@
+// Inner witnesses (feasible points of D^ss(n) found by local optimisation) against the relaxation's outer
+// intervals: every witness must lie inside every guaranteed interval. This checks the guarantee from the
+// other side than coverage of the truth: a relaxation that cut off part of D^ss(n) fails here.
+#include <gtest/gtest.h>
+
+#include "core/cerone_example.hpp"
+#include "relax/inner_points.hpp"
+#include "relax/set_membership.hpp"
+
+namespace hw::relax {
+namespace {
+
+TEST(InnerPoints, WitnessesAreFeasibleAndInsideTheGuaranteedIntervals) {
+  for (uint64_t seed : {11u, 12u}) {
+    const auto ex = SimulateCeroneExample(seed, 60, 31.0);
+    HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+    HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+    const auto truth = CeroneExample::TrueParameters();
+    ASSERT_GE(set.min_slack(truth), 0.0);
+    BoundsOptions options;
+    options.order = 1;
+    options.solver = "csdp";
+    options.threads = 2;
+    const auto outer = ComputeBounds(options, set);
+    const int l = set.orthant_of(truth);
+    int found = 0;
+    for (int k = 0; k < set.num_vars(); ++k) {
+      const auto& iv = outer.intervals[k];
+      for (int dir : {-1, +1}) {
+        const auto w = LocalExtreme(set, l, k, dir, truth);
+        if (!w.found) continue;
+        ++found;
+        EXPECT_GE(w.min_slack, 0.0);
+        EXPECT_EQ(set.orthant_of(w.point), l);
+        EXPECT_GE(set.min_slack(w.point), 0.0);
+        // The witness moved the right way from the truth (a local extreme, not just any point) ...
+        EXPECT_GE(dir * (w.value - truth[k]), -1e-9) << iv.name;
+        // ... and no valid outer interval may exclude it.
+        EXPECT_LE(iv.lower.value, w.value + 1e-6) << "seed " << seed << " " << iv.name;
+        EXPECT_GE(iv.upper.value, w.value - 1e-6) << "seed " << seed << " " << iv.name;
+      }
+    }
+    EXPECT_GE(found, 12) << "local optimisation from a strictly feasible truth should succeed for most objectives";
+  }
+}
+
+TEST(InnerPoints, AnInfeasibleRegionGivesNoWitness) {
+  const auto ex = SimulateCeroneExample(13, 60, 31.0);
+  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+  // An orthant proven empty has no feasible point: whatever Ipopt returns must fail the evaluation check.
+  const auto truth = CeroneExample::TrueParameters();
+  const int l_true = set.orthant_of(truth);
+  int rejected = 0;
+  for (int l = 0; l < set.num_orthants(); ++l) {
+    if (l == l_true) continue;
+    const auto w = LocalExtreme(set, l, 4, +1, truth);
+    if (w.found) {
+      EXPECT_GE(set.min_slack(w.point), 0.0);
+      EXPECT_EQ(set.orthant_of(w.point), l);
+    } else {
+      ++rejected;
+    }
+  }
+  EXPECT_GT(rejected, 0);
+}
+
+}  // namespace
+}  // namespace hw::relax
