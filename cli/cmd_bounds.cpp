@@ -181,7 +181,8 @@ void AddBoundsCommand(CLI::App& app) {
                summary.sdp_jobs, summary.sdp_solves, summary.jobs_from_cache, summary.largest_moments,
                summary.largest_blocks, summary.median_solve_seconds, summary.wall_seconds);
     if (!summary.all_guaranteed())
-      fmt::print("WARNING: some endpoints are conservative fallbacks (see notes); they are still valid bounds.\n");
+      fmt::print("WARNING: some endpoints are conservative fallbacks (still valid bounds) or floating-point bounds that "
+                 "verification could not prove (see notes and the verified column).\n");
     if (o->verify) {
       fmt::print("verification: {:.2f} s for {:.2f} s of SDP solves ({:.1f}%)\n", summary.verify_seconds,
                  summary.solve_seconds, summary.solve_seconds > 0 ? 100 * summary.verify_seconds / summary.solve_seconds : 0.0);
