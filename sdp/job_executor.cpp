@@ -20,19 +20,6 @@
 namespace hw::sdp {
 namespace {
 
-JobResult RunGuarded(const JobFunction& fn, const std::string& spec) {
-  JobResult r;
-  try {
-    r.text = fn(spec);
-    r.ok = true;
-  } catch (const std::exception& e) {
-    r.error = e.what();
-  } catch (...) {
-    r.error = "unknown exception";
-  }
-  return r;
-}
-
 bool WriteAll(int fd, const char* p, std::size_t n) {
   while (n > 0) {
     const ssize_t w = ::write(fd, p, n);
@@ -69,18 +56,42 @@ JobResult Decode(const Child& c, int wait_status) {
     r.error = "worker process ended without an answer";
     return r;
   }
-  r.ok = c.buffer[0] == 'O';
-  (r.ok ? r.text : r.error) = c.buffer.substr(1);
-  return r;
+  return DecodeJobResult(c.buffer);
 }
 
 }  // namespace
+
+JobResult RunJobGuarded(const JobFunction& fn, const std::string& spec) {
+  JobResult r;
+  try {
+    r.text = fn(spec);
+    r.ok = true;
+  } catch (const std::exception& e) {
+    r.error = e.what();
+  } catch (...) {
+    r.error = "unknown exception";
+  }
+  return r;
+}
+
+std::string EncodeJobResult(const JobResult& r) { return (r.ok ? "O" : "E") + (r.ok ? r.text : r.error); }
+
+JobResult DecodeJobResult(const std::string& message) {
+  JobResult r;
+  if (message.empty()) {
+    r.error = "empty answer from a worker";
+    return r;
+  }
+  r.ok = message[0] == 'O';
+  (r.ok ? r.text : r.error) = message.substr(1);
+  return r;
+}
 
 std::vector<JobResult> InProcessExecutor::Map(const std::vector<std::string>& specs, const JobFunction& fn,
                                               const JobDone& on_done) {
   std::vector<JobResult> out(specs.size());
   for (std::size_t i = 0; i < specs.size(); ++i) {
-    out[i] = RunGuarded(fn, specs[i]);
+    out[i] = RunJobGuarded(fn, specs[i]);
     if (on_done) on_done(i, out[i]);
   }
   return out;
@@ -102,8 +113,8 @@ std::vector<JobResult> ForkExecutor::Map(const std::vector<std::string>& specs, 
     if (pid < 0) throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
     if (pid == 0) {
       ::close(fds[0]);
-      const JobResult r = RunGuarded(fn, specs[i]);
-      const std::string msg = (r.ok ? "O" : "E") + (r.ok ? r.text : r.error);
+      const JobResult r = RunJobGuarded(fn, specs[i]);
+      const std::string msg = EncodeJobResult(r);
       const bool written = WriteAll(fds[1], msg.data(), msg.size());
       ::close(fds[1]);
       ::_exit(written ? 0 : 3);  // no atexit handlers, no flushing of the parent's buffers

@@ -21,6 +21,12 @@ struct JobResult {
 };
 
 using JobFunction = std::function<std::string(const std::string& spec)>;
+
+// Runs fn(spec), turning an exception into a failed result (shared by every executor).
+JobResult RunJobGuarded(const JobFunction& fn, const std::string& spec);
+// Wire format of a result between processes: 'O' + text or 'E' + error.
+std::string EncodeJobResult(const JobResult& r);
+JobResult DecodeJobResult(const std::string& message);
 // Called in the coordinating process after each job, serialised, with the job's index in the batch.
 using JobDone = std::function<void(std::size_t index, const JobResult& result)>;
 

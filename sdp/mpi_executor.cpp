@@ -24,17 +24,6 @@ std::string ReceiveText(const MPI_Status& probed) {
   return s;
 }
 
-JobResult RunGuarded(const JobFunction& fn, const std::string& spec) {
-  JobResult r;
-  try {
-    r.text = fn(spec);
-    r.ok = true;
-  } catch (const std::exception& e) {
-    r.error = e.what();
-  }
-  return r;
-}
-
 }  // namespace
 
 MpiExecutor::MpiExecutor() {
@@ -64,14 +53,8 @@ int MpiExecutor::workers() const { return size_ > 1 ? size_ - 1 : 1; }
 std::vector<JobResult> MpiExecutor::Map(const std::vector<std::string>& specs, const JobFunction& fn,
                                         const JobDone& on_done) {
   if (rank_ != 0) throw std::logic_error("MpiExecutor::Map called on a worker rank");
+  if (size_ == 1) return InProcessExecutor().Map(specs, fn, on_done);  // alone: the coordinator does the work
   std::vector<JobResult> out(specs.size());
-  if (size_ == 1) {  // alone: the coordinator does the work
-    for (std::size_t i = 0; i < specs.size(); ++i) {
-      out[i] = RunGuarded(fn, specs[i]);
-      if (on_done) on_done(i, out[i]);
-    }
-    return out;
-  }
   std::deque<int> idle;
   for (int r = 1; r < size_; ++r) idle.push_back(r);
   std::vector<long> job_of(static_cast<std::size_t>(size_), -1);
@@ -87,10 +70,7 @@ std::vector<JobResult> MpiExecutor::Map(const std::vector<std::string>& specs, c
     MPI_Probe(MPI_ANY_SOURCE, kTagResult, MPI_COMM_WORLD, &st);
     const std::string msg = ReceiveText(st);
     const auto i = static_cast<std::size_t>(job_of[static_cast<std::size_t>(st.MPI_SOURCE)]);
-    JobResult r;
-    r.ok = !msg.empty() && msg[0] == 'O';
-    (r.ok ? r.text : r.error) = msg.empty() ? "empty answer from rank " + std::to_string(st.MPI_SOURCE) : msg.substr(1);
-    out[i] = r;
+    out[i] = DecodeJobResult(msg);
     ++done;
     idle.push_back(st.MPI_SOURCE);
     if (on_done) on_done(i, out[i]);
@@ -104,8 +84,7 @@ void MpiExecutor::Serve(const JobFunction& fn) {
     MPI_Probe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
     const std::string msg = ReceiveText(st);
     if (st.MPI_TAG == kTagEnd) return;
-    const JobResult r = RunGuarded(fn, msg);
-    SendText((r.ok ? "O" : "E") + (r.ok ? r.text : r.error), 0, kTagResult);
+    SendText(EncodeJobResult(RunJobGuarded(fn, msg)), 0, kTagResult);
   }
 }
 
