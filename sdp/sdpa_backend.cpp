@@ -47,7 +47,7 @@ class CoutCapture {
 };
 
 // Expects the canonical problem of SolveCanonical(): no duplicates, no zeros, every F_i non-empty.
-SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
+SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem, SDPA::ParameterType parameters) {
   SdpSummary out;
   const auto t_wait = Clock::now();
   std::lock_guard<std::mutex> lock(SdpaMutex());
@@ -58,7 +58,7 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   const int nblocks = static_cast<int>(problem.blocks.size());
   SDPA sdpa;
   // SDPA's default parameter set, with our tolerances and iteration limit on top.
-  sdpa.setParameterType(SDPA::PARAMETER_STABLE_BUT_SLOW);
+  sdpa.setParameterType(parameters);
   sdpa.setParameterMaxIteration(options.max_iterations);
   sdpa.setParameterEpsilonStar(options.gap_tolerance);
   sdpa.setParameterEpsilonDash(options.feasibility_tolerance);
@@ -114,6 +114,9 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
   sdpa.getPhaseString(phase);
   const SDPA::PhaseType phase_value = sdpa.getPhaseValue();
   out.details = {{"phase", phase},
+                 {"parameter_set", parameters == SDPA::PARAMETER_STABLE_BUT_SLOW ? "stable_but_slow"
+                                   : parameters == SDPA::PARAMETER_DEFAULT       ? "default"
+                                                                                 : "unstable_but_fast"},
                  {"primal_obj", sdpa.getPrimalObj()},
                  {"dual_obj", sdpa.getDualObj()},
                  {"primal_error", sdpa.getPrimalError()},
@@ -157,7 +160,28 @@ SdpSummary SolveWithSdpa(const SdpOptions& options, const LmiProblem& problem) {
 }  // namespace
 
 SdpSummary SdpaSolver::Solve(const SdpOptions& options, const LmiProblem& problem) {
-  return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) { return SolveWithSdpa(options, p); });
+  // SDPA's outcome on degenerate relaxations depends on its parameter set and on the BLAS kernels of the CPU
+  // (the same problem stopped at pdFEAS 4e-6 short of the gap on one machine and was optimal on another). A
+  // solve that ends neither optimal nor with a certified infeasible/unbounded outcome is repeated with SDPA's
+  // default parameter set; the first decided outcome wins, otherwise the first attempt is returned.
+  return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) {
+    auto decided = [](const SdpSummary& s) {
+      return s.status == SdpStatus::kOptimal || s.status == SdpStatus::kInfeasible || s.status == SdpStatus::kUnbounded;
+    };
+    SdpSummary first = SolveWithSdpa(options, p, SDPA::PARAMETER_STABLE_BUT_SLOW);
+    if (decided(first)) return first;
+    SdpSummary second = SolveWithSdpa(options, p, SDPA::PARAMETER_DEFAULT);
+    second.setup_seconds += first.setup_seconds + first.solve_seconds;  // the time of both attempts counts
+    second.iterations += first.iterations;
+    if (decided(second)) {
+      second.message += " [after " + first.message + "]";
+      return second;
+    }
+    first.setup_seconds = second.setup_seconds;
+    first.details["iterations_all_attempts"] = second.iterations;  // `iterations` stays the returned attempt's
+    first.message += " [default parameters: " + second.message + "]";
+    return first;
+  });
 }
 
 }  // namespace hw::sdp

@@ -126,8 +126,11 @@ TEST(PopSuite, CsdpAndSdpaAgree) {
       const auto b = SolveRelaxation(opt, p, *sdpa);
       SCOPED_TRACE(c.name + " order " + std::to_string(order));
       ASSERT_EQ(a.status, b.status) << a.message << " | " << b.message;
+      // 1e-5 relative: both stop at relative gap and infeasibility 1e-7, and with moments up to ~1e2 the
+      // bounds can differ by ~1e-5 (measured 8.6e-6 on gloptipoly_constrained order 2, where SDPA's stable
+      // parameter set stopped at dFEAS on one machine's BLAS kernels and its default set finished).
       if (a.status == RelaxationStatus::kSolved)
-        EXPECT_NEAR(a.bound, b.bound, 1e-6 * std::max(1.0, std::abs(a.bound)));
+        EXPECT_NEAR(a.bound, b.bound, 1e-5 * std::max(1.0, std::abs(a.bound)));
     }
   }
 }

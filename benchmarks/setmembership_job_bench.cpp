@@ -1,0 +1,106 @@
+// One set-membership job (paper-001 example, one orthant, min or max of one parameter) solved by constraint
+// generation, round by round: working-set size, SDP time and iterations, status, bound, and the time spent
+// outside the solver (building the LMI, checking omitted constraints). A timing harness, not a test.
+//   setmembership_job_bench [--samples N] [--horizon n] [--order d] [--param a1] [--max] [--solver sdpa]
+//                           [--add-per-round K] [--box LO,HI]
+#include <chrono>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "core/cerone_example.hpp"
+#include "relax/constraint_generation.hpp"
+#include "relax/hw_outer_set.hpp"
+#include "sdp/sdp_solver.hpp"
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"One set-membership relaxation job, round by round"};
+  int samples = 1000, horizon = 2, order = 2, add = 20, orthant = -1;
+  std::string param = "a1", solver_name = "sdpa";
+  bool maximize = false, verify = false;
+  int contract_rounds = 0;
+  double box = 10.0;
+  std::vector<double> box_list;
+  app.add_option("--samples", samples);
+  app.add_option("--horizon", horizon);
+  app.add_option("--order", order);
+  app.add_option("--param", param);
+  app.add_flag("--max", maximize);
+  app.add_option("--solver", solver_name);
+  app.add_option("--add-per-round", add);
+  app.add_option("--orthant", orthant, "default: the true parameters' orthant");
+  app.add_option("--box", box, "prior box [-box, box] for every parameter");
+  app.add_option("--box-list", box_list, "lo1,hi1,...,lo8,hi8: a box per parameter (overrides --box)")
+      ->delimiter(',');
+  app.add_flag("--verify", verify);
+  app.add_option("--lp-contract", contract_rounds, "rounds of LP box contraction in the orthant before the job");
+  CLI11_PARSE(app, argc, argv);
+
+  const auto ex = hw::SimulateCeroneExample(1, samples);
+  hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+  std::vector<std::pair<double, double>> boxes(8, {-box, box});
+  if (box_list.size() == 16)
+    for (int i = 0; i < 8; ++i) boxes[i] = {box_list[2 * i], box_list[2 * i + 1]};
+  const int l = orthant >= 0 ? orthant
+                             : hw::relax::HwOuterSet(hw::relax::CeroneExampleStructure(), data, horizon, boxes)
+                                   .orthant_of(hw::CeroneExample::TrueParameters());
+  for (int round = 1; round <= contract_rounds; ++round) {
+    hw::relax::HwOuterSet s(hw::relax::CeroneExampleStructure(), data, horizon, boxes);
+    std::vector<hw::Polynomial> cons = s.sign_constraints(l);
+    for (auto& c : s.data_constraints(l)) cons.push_back(c.g);
+    const auto tc = Clock::now();
+    auto lp_solver = hw::sdp::MakeSolver(solver_name);
+    fmt::print("LP contraction round {}:", round);
+    for (int i = 0; i < 8; ++i) {
+      const auto lo = hw::relax::LinearProgramBound(cons, 8, i, -1, {}, *lp_solver);
+      const auto hi = hw::relax::LinearProgramBound(cons, 8, i, +1, {}, *lp_solver);
+      const double nlo = lo.status == lo.kBounded ? s.scaling().to_original(i, lo.bound) : boxes[i].first;
+      const double nhi = hi.status == hi.kBounded ? s.scaling().to_original(i, hi.bound) : boxes[i].second;
+      boxes[i] = {std::max(boxes[i].first, nlo), std::min(boxes[i].second, nhi)};
+      fmt::print(" {} [{:.4f}, {:.4f}]", s.layout().names[i], boxes[i].first, boxes[i].second);
+    }
+    fmt::print("  ({:.2f} s)\n", since(tc));
+  }
+  hw::relax::HwOuterSet set(hw::relax::CeroneExampleStructure(), data, horizon, boxes);
+  const auto& names = set.layout().names;
+  const int k = static_cast<int>(std::find(names.begin(), names.end(), param) - names.begin());
+  if (k >= set.num_vars()) {
+    fmt::print(stderr, "unknown parameter {}\n", param);
+    return 2;
+  }
+  std::vector<hw::Polynomial> candidates;
+  for (auto& c : set.data_constraints(l)) candidates.push_back(std::move(c.g));
+  hw::relax::PolyProblem core;
+  core.num_vars = set.num_vars();
+  core.objective = hw::Polynomial::Variable(core.num_vars, k);
+  core.maximize = maximize;
+  core.inequalities = set.box_constraints();
+  for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(g);
+  hw::relax::ConstraintGenerationOptions gen;
+  gen.order = order;
+  gen.add_per_round = add;
+  gen.verify.enabled = verify;
+  gen.sdp.acceptable_gap = 1e-5;
+  gen.sdp.infeasibility_tolerance = 0.5;
+  auto solver = hw::sdp::MakeSolver(solver_name);
+  fmt::print("N={} n={} order={} orthant {} {} {} ({} candidates), solver {}\n", samples, horizon, order, l,
+             maximize ? "max" : "min", param, candidates.size(), solver_name);
+  fmt::print("{:>5} {:>5} {:>9} {:>9}\n", "round", "K", "elapsed", "");
+  const auto t0 = Clock::now();
+  int round = 0;
+  const auto r = hw::relax::SolveWithConstraintGeneration(
+      gen, core, candidates, {}, *solver, [&](const std::vector<int>& ws) {
+        fmt::print("{:>5} {:>5} {:>9.2f}\n", ++round, ws.size(), since(t0));
+        std::fflush(stdout);
+      });
+  fmt::print("status {} bound {:.6f} (original units {:.6f}) tight {} rounds {} iterations {} solver {:.2f} s of "
+             "{:.2f} s wall\n{}\nlast SDP: {}\n",
+             hw::relax::ToString(r.status), r.bound, set.scaling().to_original(k, r.bound), r.tight, r.rounds,
+             r.sdp_iterations, r.solve_seconds, since(t0), r.message, r.last_sdp.message);
+  return 0;
+}
