@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -60,6 +62,33 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
       result.message += "; " + result.verification.message;
     }
   };
+  // The last round whose LMI was solved: its bound is valid for the full set too (it relaxes a subset of the
+  // inequalities), so a later round that the solver fails on falls back to it instead of losing it.
+  struct SolvedRound {
+    PolyProblem problem;
+    std::unique_ptr<MomentRelaxation> relaxation;
+    sdp::SdpSummary sdp;
+    sdp::SdpSolver* used = nullptr;
+    std::vector<int> working;
+    double max_violation = 0.0;
+  };
+  std::optional<SolvedRound> last_solved;
+  auto fall_back = [&](const std::string& why) {
+    if (!last_solved) return false;
+    const auto& r = *last_solved;
+    const double sign = r.relaxation->objective_sign();
+    result.status = RelaxationStatus::kSolved;
+    result.tight = false;
+    result.bound = sign * r.sdp.lower_bound;
+    result.primal_value = sign * r.sdp.primal_value;
+    result.max_violation = r.max_violation;
+    result.working_set = r.working;
+    result.message = fmt::format("{}; the bound of the last solved round ({} of {} data constraints) is reported: "
+                                 "valid, possibly looser than the full relaxation's",
+                                 why, r.working.size(), candidates.size());
+    verify_bound(r.problem, *r.relaxation, r.sdp, *r.used);
+    return true;
+  };
   for (int round = 1; round <= options.max_rounds; ++round) {
     result.rounds = round;
     PolyProblem problem = core;
@@ -95,9 +124,12 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
       }
       if (!result.verification.verified()) {
         result.last_sdp = sdp;
+        const std::string why = fmt::format("relaxation reported infeasible, but {}: the set is NOT declared empty",
+                                            result.verification.message);
+        result.verification = {};
+        if (fall_back(why)) return result;
         result.status = RelaxationStatus::kSolverFailed;
-        result.message = fmt::format("relaxation reported infeasible, but {}: the set is NOT declared empty",
-                                     result.verification.message);
+        result.message = why;
         return result;
       }
     }
@@ -114,8 +146,11 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
       return result;
     }
     if (sdp.status != sdp::SdpStatus::kOptimal) {
+      const std::string why = fmt::format("round {}: {}: {} ({})", round, sdp.solver, sdp::ToString(sdp.status),
+                                          sdp.message);
+      if (fall_back(why)) return result;
       result.status = RelaxationStatus::kSolverFailed;
-      result.message = fmt::format("{}: {} ({})", sdp.solver, sdp::ToString(sdp.status), sdp.message);
+      result.message = why;
       return result;
     }
     const double sign = relaxation.objective_sign();
@@ -159,6 +194,8 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
       verify_bound(problem, relaxation, sdp, *used);
       return result;
     }
+    last_solved = SolvedRound{problem, std::make_unique<MomentRelaxation>(std::move(relaxation)), sdp, used,
+                              result.working_set, result.max_violation};
     std::sort(violated.rbegin(), violated.rend());
     for (int k = 0; k < std::min<int>(options.add_per_round, violated.size()); ++k) working.insert(violated[k].second);
   }
@@ -209,12 +246,20 @@ sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const Momen
   return out;
 }
 
-sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constraints, int num_vars,
-                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver,
-                                        sdp::VerifiedBound* certificate) {
+namespace {
+
+// The LP of ScreenWithLinearProgram / LinearProgramBound: every monomial of degree <= D a free variable y with
+// |y| <= 1 and y >= 0 for even monomials; one row per constraint.
+struct MomentLp {
+  sdp::LmiProblem lp;
+  MonomialBasis basis;
+};
+
+MomentLp BuildMomentLp(const std::vector<Polynomial>& constraints, int num_vars) {
   int D = 1;
   for (const auto& g : constraints) D = std::max(D, g.degree());
-  const MonomialBasis basis(num_vars, D);
+  MomentLp out{sdp::LmiProblem{}, MonomialBasis(num_vars, D)};
+  const MonomialBasis& basis = out.basis;
   const int m = static_cast<int>(basis.size()) - 1;
   std::vector<int> even;
   for (int i = 1; i <= m; ++i) {
@@ -223,9 +268,9 @@ sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constrain
     if (all_even) even.push_back(i);
   }
   const int rows = static_cast<int>(constraints.size()) + 2 * m + static_cast<int>(even.size());
-  sdp::LmiProblem lp;
+  sdp::LmiProblem& lp = out.lp;
   lp.blocks.push_back({sdp::BlockSpec::Kind::kDiagonal, rows});
-  lp.c.assign(m, 0.0);  // feasibility problem
+  lp.c.assign(m, 0.0);  // feasibility problem unless the caller sets an objective
   lp.F.assign(m + 1, {});
   int r = 0;
   for (const auto& g : constraints) {
@@ -250,23 +295,74 @@ sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constrain
     lp.F[k].push_back({0, r, r, 1.0});
     ++r;
   }
-  if (!certificate) return solver.Solve(options, lp);
+  return out;
+}
+
+// Keeps an infeasibility claim of the LP only with a verified certificate (|y| <= 1 is part of the LP).
+void CertifyLpInfeasibility(const sdp::LmiProblem& lp, sdp::SdpSummary& s, sdp::VerifiedBound* certificate) {
+  if (s.status != sdp::SdpStatus::kInfeasible) return;
+  *certificate = sdp::VerifyInfeasibility(lp, s.X, sdp::VariableBounds::Uniform(lp.num_vars(), -1.0, 1.0));
+  if (!certificate->verified()) {
+    s.status = sdp::SdpStatus::kNumericalTrouble;
+    s.message += "; " + certificate->message;
+  }
+}
+
+}  // namespace
+
+sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constraints, int num_vars,
+                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver,
+                                        sdp::VerifiedBound* certificate) {
+  const MomentLp built = BuildMomentLp(constraints, num_vars);
+  if (!certificate) return solver.Solve(options, built.lp);
   sdp::SdpOptions keep = options;
   keep.keep_dual_matrix = true;
-  auto s = solver.Solve(keep, lp);
-  if (s.status == sdp::SdpStatus::kInfeasible) {
-    // Rows 1 - y >= 0 and 1 + y >= 0 hold for every feasible y of the LP.
-    *certificate = sdp::VerifyInfeasibility(lp, s.X, sdp::VariableBounds::Uniform(m, -1.0, 1.0));
-    if (!certificate->verified()) {
-      s.status = sdp::SdpStatus::kNumericalTrouble;
-      s.message += "; " + certificate->message;
-    }
-  }
+  auto s = solver.Solve(keep, built.lp);
+  CertifyLpInfeasibility(built.lp, s, certificate);
   if (!options.keep_dual_matrix) {
     s.X.clear();
     s.Z.clear();
   }
   return s;
+}
+
+LinearProgramBoundResult LinearProgramBound(const std::vector<Polynomial>& constraints, int num_vars, int variable,
+                                            int direction, const sdp::SdpOptions& options, sdp::SdpSolver& solver) {
+  LinearProgramBoundResult out;
+  MomentLp built = BuildMomentLp(constraints, num_vars);
+  Exponents e(num_vars, 0);
+  e[variable] = 1;
+  const long k = built.basis.index_of(e);
+  // The LP minimises: min x_k, or min -x_k for the maximum.
+  built.lp.c[k - 1] = direction < 0 ? 1.0 : -1.0;
+  sdp::SdpOptions keep = options;
+  keep.keep_dual_matrix = true;
+  auto s = solver.Solve(keep, built.lp);
+  out.summary_message = s.message;
+  if (s.status == sdp::SdpStatus::kInfeasible) {
+    sdp::VerifiedBound cert;
+    CertifyLpInfeasibility(built.lp, s, &cert);
+    out.status = s.status == sdp::SdpStatus::kInfeasible ? LinearProgramBoundResult::kEmpty
+                                                          : LinearProgramBoundResult::kFailed;
+    return out;
+  }
+  if (s.status != sdp::SdpStatus::kOptimal && s.status != sdp::SdpStatus::kInaccurate &&
+      s.status != sdp::SdpStatus::kIterationLimit) {
+    out.status = LinearProgramBoundResult::kFailed;
+    return out;
+  }
+  // Any multiplier X gives a rigorous bound (weak duality with |y| <= 1), optimal or not: verify it, and use
+  // the box edge when the verified value is not finite.
+  const auto v = sdp::VerifyLowerBound(built.lp, s.X, sdp::VariableBounds::Uniform(built.lp.num_vars(), -1.0, 1.0),
+                                       s.lower_bound);
+  if (!v.verified() || !std::isfinite(v.bound)) {
+    out.status = LinearProgramBoundResult::kFailed;
+    out.summary_message += "; " + v.message;
+    return out;
+  }
+  out.status = LinearProgramBoundResult::kBounded;
+  out.bound = std::clamp(direction < 0 ? v.bound : -v.bound, -1.0, 1.0);
+  return out;
 }
 
 }  // namespace hw::relax

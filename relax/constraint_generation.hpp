@@ -71,4 +71,15 @@ sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constrain
                                         const sdp::SdpOptions& options, sdp::SdpSolver& solver,
                                         sdp::VerifiedBound* certificate = nullptr);
 
+// Rigorous bound of min (direction -1) or max (+1) of x_variable over { g_i(x) >= 0 } inside [-1, 1]^n from the
+// LP of ScreenWithLinearProgram: the bound is verified from the LP's multiplier (sdp/verified_bound.hpp), so it
+// holds whatever the solver's accuracy. Used to contract the prior box before the relaxations (set_membership).
+struct LinearProgramBoundResult {
+  enum Status { kBounded, kEmpty, kFailed } status = kFailed;  // kEmpty: verified certificate that the set is empty
+  double bound = 0.0;  // in [-1, 1], valid when kBounded
+  std::string summary_message;
+};
+LinearProgramBoundResult LinearProgramBound(const std::vector<Polynomial>& constraints, int num_vars, int variable,
+                                            int direction, const sdp::SdpOptions& options, sdp::SdpSolver& solver);
+
 }  // namespace hw::relax
