@@ -67,6 +67,7 @@ void AddBoundsCommand(CLI::App& app) {
     double noise_bound = 0.0;
     int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
     bool proper = false, no_cheap = false, quiet = false, verify = true;
+    int contraction_passes = 1;
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--data", o->data, "recording CSV with a header")->required();
@@ -90,6 +91,9 @@ void AddBoundsCommand(CLI::App& app) {
       ->check(CLI::IsMember({"fork", "inprocess", "mpi"}));
   cmd->add_option("--run-dir", o->run_dir, "keep finished SDP results here; a rerun solves only the rest");
   cmd->add_flag("--no-cheap-pass", o->no_cheap, "solve every orthant at full order (no minimal-order screening)");
+  cmd->add_option("--contract-passes", o->contraction_passes,
+                  "cheap passes repeated in each orthant's contracted box (0 = no box contraction)")
+      ->check(CLI::Range(0, 10));
   cmd->add_flag("--verify,!--no-verify", o->verify,
                 "verify every bound and emptiness certificate rigorously (interval arithmetic; default on)");
   cmd->add_option("--params", o->params, "only these intervals (names such as a1 b1; default: all)")->delimiter(',');
@@ -128,6 +132,7 @@ void AddBoundsCommand(CLI::App& app) {
     options.executor = sdp::MakeExecutor(o->executor, o->threads);
     options.run_dir = o->run_dir;
     options.cheap_pass = !o->no_cheap;
+    options.contraction_passes = o->contraction_passes;
     options.parameters = o->params;
     options.generation.verify.enabled = o->verify;
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
@@ -175,6 +180,11 @@ void AddBoundsCommand(CLI::App& app) {
     fmt::print("\nprior box (assumption): ");
     for (std::size_t i = 0; i < names.size(); ++i)
       fmt::print("{}{} in [{}, {}]", i ? ", " : "", names[i], summary.box[i].first, summary.box[i].second);
+    for (const auto& [l, b] : summary.orthant_boxes) {
+      fmt::print("\ncontracted box of orthant {} (proven to hold its points of D^ss(n) in the prior box): ", l);
+      for (std::size_t i = 0; i < names.size(); ++i)
+        fmt::print("{}{} in [{:.6g}, {:.6g}]", i ? ", " : "", names[i], b[i].first, b[i].second);
+    }
     fmt::print("\northants: {} total, {} proven empty, {} solved, {} failed; {} relaxation jobs ({} SDP solves, "
                "{} from cache), largest SDP {} moments / {} blocks, median solve {:.2f} s, wall {:.1f} s\n",
                summary.orthants_total, summary.orthants_empty, summary.orthants_solved, summary.orthants_failed,

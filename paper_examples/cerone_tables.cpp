@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Reproduce Tables I-III of Cerone, Piga, Regruto (set-membership HW identification)"};
   std::string out = "out/cerone", solver = "sdpa", run_dir = "runs/cerone", horizons_text = "2,3";
   uint64_t seed = 1;
-  int samples = 1000, order = 3, threads = 0;
+  int samples = 1000, order = 3, threads = 0, contraction_passes = 1;
   bool verify = true;
   app.add_option("--out", out, "output directory");
   app.add_option("--seed", seed, "noise/input seed");
@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
   app.add_option("--horizons", horizons_text, "comma list of dynamic horizons n");
   app.add_option("--solver", solver, "csdp or sdpa");
   app.add_option("--threads", threads, "parallel SDP jobs (0 = all cores)");
+  app.add_option("--contract-passes", contraction_passes, "cheap passes in contracted boxes (0 = off)");
   app.add_option("--run-dir", run_dir, "resumable cache of finished SDPs ('' to disable)");
   app.add_flag("--verify,!--no-verify", verify, "verify every bound rigorously (default on)");
   CLI11_PARSE(app, argc, argv);
@@ -82,6 +83,7 @@ int main(int argc, char** argv) {
     options.order = order;
     options.solver = solver;
     options.threads = threads;
+    options.contraction_passes = contraction_passes;
     options.run_dir = run_dir;
     options.generation.verify.enabled = verify;
     const auto summary = hw::relax::ComputeBounds(options, set, [](const hw::relax::BoundsProgress& p) {

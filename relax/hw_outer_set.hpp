@@ -91,6 +91,10 @@ class HwOuterSet {
   // Box constraints 1 - p~_i^2 >= 0.
   std::vector<Polynomial> box_constraints() const;
   const std::vector<std::pair<double, double>>& box() const { return box_; }
+  const HwStructure& structure() const { return structure_; }
+  const HwData& data() const { return data_; }
+  // The same data, model class and horizon in another box (a contracted one: same set inside it, new scaling).
+  HwOuterSet WithBox(std::vector<std::pair<double, double>> box) const { return {structure_, data_, horizon_, std::move(box)}; }
   // Evaluates the unscaled model equations' worst-case slack of a parameter point (for tests):
   // min over constraints of the constraint value at p (>= 0 iff p lies in D^ss(n) for its orthant).
   double min_slack(const std::vector<double>& p) const;

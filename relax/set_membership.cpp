@@ -127,6 +127,9 @@ bool BoundsOptions::IsValid(std::string* error) const {
   };
   if (order < 1) return fail("order must be >= 1");
   if (threads < 0) return fail("threads must be >= 0");
+  if (contraction_passes < 0) return fail("contraction_passes must be >= 0");
+  if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
+  if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
   if (solver != "csdp" && solver != "sdpa") return fail(fmt::format("solver '{}' unknown; expected csdp or sdpa", solver));
   ConstraintGenerationOptions g = generation;
   return g.IsValid(error);
@@ -166,6 +169,13 @@ nlohmann::json BoundsSummary::to_json() const {
                  {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds}};
   j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
   j["all_guaranteed"] = all_guaranteed();
+  j["contraction_passes_run"] = contraction_passes_run;
+  for (const auto& [l, b] : orthant_boxes) {
+    nlohmann::json bj = nlohmann::json::array();
+    for (std::size_t i = 0; i < b.size(); ++i)
+      bj.push_back({{"parameter", parameter_names[i]}, {"lo", b[i].first}, {"hi", b[i].second}});
+    j["contracted_boxes"].push_back({{"orthant", l}, {"box", bj}});
+  }
   return j;
 }
 
@@ -204,21 +214,48 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
       for (const auto& nm : set.layout().names) all += (all.empty() ? "" : ", ") + nm;
       throw InputError(fmt::format("no parameter '{}'; the parameters are: {}", name, all));
     }
+  // Box contraction needs the bounds of every parameter; only the wanted ones are reported and go to full order.
+  std::vector<int> objective_params = wanted;
+  if (options.contraction_passes > 0) {
+    objective_params.clear();
+    for (int k = 0; k < n; ++k) objective_params.push_back(k);
+  }
   std::vector<Objective> objectives;
-  for (int k : wanted) {
+  for (int k : objective_params) {
     objectives.push_back({k, -1});
     objectives.push_back({k, +1});
   }
   const int num_obj = static_cast<int>(objectives.size());
-
-  std::vector<std::vector<Polynomial>> candidates(L);
-  std::vector<std::once_flag> built(L);
-  auto candidates_of = [&](int l) -> const std::vector<Polynomial>& {
-    std::call_once(built[l], [&] {
-      for (auto& c : set.data_constraints(l)) candidates[l].push_back(std::move(c.g));
-    });
-    return candidates[l];
+  auto objective_index = [&](int k, int dir) {
+    const int w = static_cast<int>(std::find(objective_params.begin(), objective_params.end(), k) - objective_params.begin());
+    return 2 * w + (dir > 0 ? 1 : 0);
   };
+  auto is_wanted = [&](int o) { return std::find(wanted.begin(), wanted.end(), objectives[o].param) != wanted.end(); };
+
+  // The outer set in each box a job names (the prior box, or an orthant's contracted box), and each orthant's
+  // data inequalities in it, built once per process (before forking, the workers inherit them).
+  using Box = std::vector<std::pair<double, double>>;
+  std::mutex sets_mutex;
+  std::map<std::string, std::unique_ptr<HwOuterSet>> sets_by_box;
+  std::map<std::pair<std::string, int>, std::vector<Polynomial>> candidates_by_box;
+  auto box_key = [](const Box& b) { return nlohmann::json(b).dump(); };
+  auto set_for = [&](const Box& b) -> const HwOuterSet& {
+    if (b == set.box()) return set;
+    std::lock_guard<std::mutex> lock(sets_mutex);
+    auto& slot = sets_by_box[box_key(b)];
+    if (!slot) slot = std::make_unique<HwOuterSet>(set.WithBox(b));
+    return *slot;
+  };
+  auto candidates_for = [&](const Box& b, int l) -> const std::vector<Polynomial>& {
+    const HwOuterSet& s = set_for(b);
+    std::lock_guard<std::mutex> lock(sets_mutex);
+    auto& c = candidates_by_box[{box_key(b), l}];
+    if (c.empty())
+      for (auto& d : s.data_constraints(l)) c.push_back(std::move(d.g));
+    return c;
+  };
+  auto candidates_of = [&](int l) -> const std::vector<Polynomial>& { return candidates_for(set.box(), l); };
+  std::vector<Box> boxes(L, set.box());  // each orthant's current box
 
   // One job, as text, so that it can run in a forked worker or on another MPI rank. A job depends only on
   // (options, set) and its spec: {"kind": "lp", "l"} screens orthant l; {"kind": "relax", "l", "o", "d",
@@ -241,6 +278,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
           .dump();
     }
     const Objective obj = objectives.at(spec.at("o").get<std::size_t>());
+    const Box job_box = spec.contains("box") ? spec.at("box").get<Box>() : set.box();
+    const HwOuterSet& set = set_for(job_box);  // the job's box (shadows the prior-box set on purpose)
     PolyProblem core;
     core.num_vars = n;
     core.objective = Polynomial::Variable(n, obj.param);
@@ -249,9 +288,10 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(std::move(g));
     ConstraintGenerationOptions gen = opts.generation;
     gen.order = spec.at("d");
+    if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
     auto solver = sdp::MakeSolver(options.solver);
     auto other = sdp::MakeSolver(options.solver == "csdp" ? "sdpa" : "csdp");
-    const auto r = SolveWithConstraintGeneration(gen, core, candidates_of(l), spec.at("initial").get<std::vector<int>>(),
+    const auto r = SolveWithConstraintGeneration(gen, core, candidates_for(job_box, l), spec.at("initial").get<std::vector<int>>(),
                                                  *solver, {}, options.retry_with_other_solver ? other.get() : nullptr);
     JobOutcome out;
     out.rounds = r.rounds;
@@ -300,7 +340,10 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                          {"solver", options.solver}, {"box", set.box()},
                          {"violation_tolerance", options.generation.violation_tolerance},
                          {"gap_tolerance", options.generation.sdp.gap_tolerance},
-                         {"verify", options.generation.verify.enabled}};
+                         {"verify", options.generation.verify.enabled},
+                         {"contraction_passes", options.contraction_passes},
+                         {"contraction_min_shrink", options.contraction_min_shrink},
+                         {"contraction_max_rounds", options.contraction_max_rounds}};
   uint64_t h = 1469598103934665603ull;
   const std::string meta_text = meta.dump();
   h = fnv(h, meta_text.data(), meta_text.size());
@@ -366,16 +409,28 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     }
   }
 
+  // Cheap order at the minimal order (also the final pass when order == minimal).
+  // The cheap pass needs informative bounds to skip anything: order 1 (Shor) returns the box edges for these
+  // problems, so the cheap order is at least 2; with nothing cheaper than the target order, no cheap pass.
+  const int cheap_order = options.cheap_pass ? std::min(options.order, std::max(min_order, 2)) : options.order;
+
   // Relaxation jobs (orthant l, objective o, order d): cached ones are read, the rest run on the executor.
   // Bookkeeping (working sets shared between jobs of one orthant, emptiness, statistics) stays here.
+  // max_rounds > 0 caps constraint generation (contraction passes); such jobs have their own cache entries.
   auto run_jobs = [&](const std::vector<std::tuple<int, int, int>>& jobs, const std::string& phase,
-                      const std::function<void()>& on_each) {
+                      const std::function<void()>& on_each, int max_rounds = 0) {
     std::vector<JobOutcome> outs(jobs.size());
     std::vector<std::string> specs;
     std::vector<std::size_t> spec_job;
     auto key_of = [&](int l, int o, int d) {
       const Objective obj = objectives[o];
-      return fmt::format("o{}_l{}_{}_{}", d, l, set.layout().names[obj.param], obj.dir < 0 ? "min" : "max");
+      std::string key = fmt::format("o{}_l{}_{}_{}", d, l, set.layout().names[obj.param], obj.dir < 0 ? "min" : "max");
+      if (boxes[l] != set.box()) {  // a contracted box: its own job
+        const std::string b = box_key(boxes[l]);
+        key += fmt::format("_b{:016x}", fnv(1469598103934665603ull, b.data(), b.size()));
+      }
+      if (max_rounds > 0) key += fmt::format("_r{}", max_rounds);
+      return key;
     };
     for (std::size_t i = 0; i < jobs.size(); ++i) {
       const auto [l, o, d] = jobs[i];
@@ -391,10 +446,13 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
         if (on_each) on_each();
         continue;
       }
-      const auto& ws = working[{l, d}];
-      specs.push_back(nlohmann::json{{"kind", "relax"}, {"l", l}, {"o", o}, {"d", d},
-                                     {"initial", std::vector<int>(ws.begin(), ws.end())}}
-                          .dump());
+      // A first job at a higher order starts from the inequalities the cheap order found active.
+      const auto& ws = working[{l, d}].empty() ? working[{l, cheap_order}] : working[{l, d}];
+      candidates_for(boxes[l], l);  // built here, inherited by forked workers
+      nlohmann::json spec{{"kind", "relax"}, {"l", l}, {"o", o}, {"d", d}, {"box", boxes[l]},
+                          {"initial", std::vector<int>(ws.begin(), ws.end())}};
+      if (max_rounds > 0) spec["max_rounds"] = max_rounds;
+      specs.push_back(spec.dump());
       spec_job.push_back(i);
     }
     executor->Map(specs, job_function, [&](std::size_t s, const sdp::JobResult& r) {
@@ -423,21 +481,62 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     return outs;
   };
 
-  // 2. Cheap pass at the minimal order (also the final pass when order == minimal).
-  // The cheap pass needs informative bounds to skip anything: order 1 (Shor) returns the box edges for these
-  // problems, so the cheap order is at least 2; with nothing cheaper than the target order, no cheap pass.
-  const int cheap_order = options.cheap_pass ? std::min(options.order, std::max(min_order, 2)) : options.order;
+  // 2. Cheap pass at the cheap order, repeated in contracted boxes (box contraction, see BoundsOptions).
   std::map<std::pair<int, int>, JobOutcome> cheap;  // (orthant, objective)
-  {
+  const bool verify_on = opts.generation.verify.enabled;
+  for (int pass = 0;; ++pass) {
     std::vector<std::tuple<int, int, int>> jobs;
-    for (int l : alive) {
-      candidates_of(l);  // built once here, shared with forked workers
-      for (int o = 0; o < num_obj; ++o) jobs.push_back({l, o, cheap_order});
-    }
+    for (int l : alive)
+      if (!is_empty(l))
+        for (int o = 0; o < num_obj; ++o) jobs.push_back({l, o, cheap_order});
     int done = 0;
-    const std::string phase = fmt::format("order {} relaxations", cheap_order);
-    const auto outs = run_jobs(jobs, phase, [&] { report(phase, ++done, static_cast<int>(jobs.size())); });
+    // Passes before the last contract boxes with capped jobs; the last one is the cheap pass proper.
+    const bool contracting = pass < options.contraction_passes;
+    const std::string phase = contracting ? fmt::format("order {} box contraction {}", cheap_order, pass + 1)
+                                          : fmt::format("order {} relaxations", cheap_order);
+    const auto outs = run_jobs(
+        jobs, phase, [&] { report(phase, ++done, static_cast<int>(jobs.size())); },
+        contracting ? std::min(options.contraction_max_rounds, opts.generation.max_rounds) : 0);
     for (std::size_t i = 0; i < jobs.size(); ++i) cheap[{std::get<0>(jobs[i]), std::get<1>(jobs[i])}] = outs[i];
+    if (options.contraction_passes == 0) break;
+    // Contract every orthant's box to its cheap bounds (a bound only counts when verified, or when
+    // verification is off); the largest relative shrink decides whether another pass is worth it.
+    double shrink = 0.0;
+    for (int l : alive) {
+      if (is_empty(l)) continue;
+      Box next = boxes[l];
+      bool crossed = false;
+      for (int k = 0; k < n; ++k) {
+        const double width = next[k].second - next[k].first;
+        for (int dir : {-1, +1}) {
+          const auto& r = cheap.at({l, objective_index(k, dir)});
+          if (r.status != "solved" || (verify_on && r.verification != "verified")) continue;
+          if (dir < 0) next[k].first = std::max(next[k].first, r.bound);
+          else next[k].second = std::min(next[k].second, r.bound);
+        }
+        if (next[k].first > next[k].second) {
+          crossed = true;  // rigorous bounds that cross: no point of the orthant in the box
+          break;
+        }
+        // A box side of (near) zero width would break the scaling: keep a sliver (widening stays valid).
+        const double prior_width = set.box()[k].second - set.box()[k].first;
+        const double min_width = 1e-6 * prior_width;
+        if (next[k].second - next[k].first < min_width) {
+          const double mid = 0.5 * (next[k].first + next[k].second);
+          next[k] = {std::max(set.box()[k].first, mid - min_width), std::min(set.box()[k].second, mid + min_width)};
+        }
+        shrink = std::max(shrink, 1.0 - (next[k].second - next[k].first) / width);
+      }
+      if (crossed) {
+        orthant_status[l] = fmt::format("empty (order {}, contracted box)", cheap_order);
+        continue;
+      }
+      boxes[l] = next;
+    }
+    if (!contracting) break;
+    summary.contraction_passes_run = pass + 1;
+    // Little movement: skip the remaining contraction passes and run the last (full) cheap pass.
+    if (shrink < options.contraction_min_shrink) pass = std::max(pass, options.contraction_passes - 1);
   }
 
   // 3. Full pass: per objective, orthants by cheap bound (most extreme first), skipped when unable to move it.
@@ -450,11 +549,12 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     int total_est = 0;
     for (int o = 0; o < num_obj; ++o)
       for (int l : alive)
-        if (!is_empty(l)) ++total_est;
+        if (!is_empty(l) && is_wanted(o)) ++total_est;
     int finished = 0;
     while (true) {
       std::vector<std::pair<int, int>> wave;
       for (int o = 0; o < num_obj; ++o) {
+        if (!is_wanted(o)) continue;
         const int dir = objectives[o].dir;
         int best = -1;
         double best_val = 0.0;
@@ -492,7 +592,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     // extreme than the aggregate, or they would have been solved).
     for (int l : alive)
       for (int o = 0; o < num_obj; ++o)
-        if (!full.count({l, o}) && !is_empty(l)) {
+        if (!full.count({l, o}) && !is_empty(l) && is_wanted(o)) {
           auto c = cheap.at({l, o});
           c.message = "skipped at full order: its order-" + std::to_string(cheap_order) + " bound cannot move the interval";
           c.status = c.status == "solved" ? "skipped" : c.status;
@@ -506,7 +606,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     ParameterInterval iv;
     iv.name = set.layout().names[k];
     for (int dir : {-1, +1}) {
-      const int o = 2 * static_cast<int>(w) + (dir > 0 ? 1 : 0);
+      const int o = objective_index(k, dir);
       Endpoint ep;
       ep.status = "empty";
       bool any = false;
@@ -536,8 +636,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
             note = fmt::format("order-{} solve failed in orthant {} ({}); order-{} bound used", options.order, l,
                                r.message, cheap_order);
           } else {
-            v = fv = dir < 0 ? set.box()[k].first : set.box()[k].second;
-            ver = verify ? "verified" : "off";  // the prior box edge is exact
+            // The orthant's box edge: the prior box, or a contracted box proven to contain the orthant's points.
+            v = fv = dir < 0 ? boxes[l][k].first : boxes[l][k].second;
+            ver = verify ? "verified" : "off";
             note = fmt::format("solve failed in orthant {} ({}); box edge used", l, r.message);
           }
           status = "conservative";
@@ -582,6 +683,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
     else ++summary.orthants_solved;
     summary.orthants.push_back({l, sign_text(set, l), orthant_status[l]});
   }
+  for (int l : alive)
+    if (!is_empty(l) && boxes[l] != set.box()) summary.orthant_boxes.push_back({l, boxes[l]});
   std::sort(solve_times.begin(), solve_times.end());
   if (!solve_times.empty()) summary.median_solve_seconds = solve_times[solve_times.size() / 2];
   summary.wall_seconds = seconds_since(t0);

@@ -5,7 +5,9 @@
 //  1. LP screen of every sign orthant (ScreenWithLinearProgram): an infeasible LP proves the orthant empty.
 //  2. Cheap pass at the minimal order delta0 = ceil((n+1)/2) for every objective (min/max of every
 //     parameter) of every surviving orthant, by constraint generation. An infeasible relaxation proves
-//     the orthant empty.
+//     the orthant empty. With box contraction on, the first cheap passes (few constraint-generation rounds
+//     each) contract each orthant's box to its bounds, and the last cheap pass runs in the contracted box
+//     (BoundsOptions::contraction_passes).
 //  3. Full pass at order delta: for each objective, orthants are solved in order of their cheap bound,
 //     most extreme first, and an orthant is skipped when its cheap bound cannot move the aggregated
 //     interval (its order-delta bound is at least as tight as its order-delta0 bound: Property 3).
@@ -39,6 +41,19 @@ struct BoundsOptions {
   std::shared_ptr<sdp::JobExecutor> executor;
   std::string run_dir;           // resumable cache; empty = none
   std::vector<std::string> parameters;  // intervals to compute (names); empty = every parameter
+  // Box contraction (bound tightening). The cheap-order bounds of EVERY parameter in an orthant form a box
+  // that contains the orthant's part of D^ss(n) inside the prior box, so relaxations in that smaller box bound
+  // the same set: they stay valid, are at least as tight, and are far better conditioned (a thin set in a wide
+  // box makes the moment matrices nearly singular; docs/setmembership_scale.md). After the first cheap pass,
+  // up to `contraction_passes` more cheap passes run in the contracted boxes while some side still moves by
+  // more than `contraction_min_shrink` of its width; the full-order pass runs in the last boxes. Only
+  // verified bounds contract a box (or any solved bound with verification off). 0 = off.
+  int contraction_passes = 1;
+  double contraction_min_shrink = 0.05;
+  // Constraint-generation rounds of a job in a contraction pass (every pass but the last): a subset of the
+  // data inequalities already gives a valid bound, and the prior box's ill-conditioned LMIs are kept small.
+  // The last cheap pass always runs to the full relaxation (generation.max_rounds).
+  int contraction_max_rounds = 4;
   ConstraintGenerationOptions generation;  // its order is set per pass
   bool IsValid(std::string* error) const;
 };
@@ -90,6 +105,9 @@ struct BoundsSummary {
   bool worker_rank = false;   // true on MPI worker ranks: they served jobs and hold no result
   std::vector<std::pair<double, double>> box;
   std::vector<std::string> parameter_names;
+  // Contracted box of every orthant left at the end (index, box), and the cheap passes run in contracted boxes.
+  std::vector<std::pair<int, std::vector<std::pair<double, double>>>> orthant_boxes;
+  int contraction_passes_run = 0;
   nlohmann::json to_json() const;
   bool all_guaranteed() const;
 };
