@@ -67,7 +67,7 @@ void AddBoundsCommand(CLI::App& app) {
     double noise_bound = 0.0;
     int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
     bool proper = false, no_cheap = false, quiet = false, verify = true;
-    int contraction_passes = 1;
+    int contraction_passes = 0;
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--data", o->data, "recording CSV with a header")->required();

@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Reproduce Tables I-III of Cerone, Piga, Regruto (set-membership HW identification)"};
   std::string out = "out/cerone", solver = "sdpa", run_dir = "runs/cerone", horizons_text = "2,3";
   uint64_t seed = 1;
-  int samples = 1000, order = 3, threads = 0, contraction_passes = 1;
+  int samples = 1000, order = 3, threads = 0, contraction_passes = 0;
   bool verify = true;
   app.add_option("--out", out, "output directory");
   app.add_option("--seed", seed, "noise/input seed");

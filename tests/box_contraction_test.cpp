@@ -1,0 +1,182 @@
+// Robustness and box contraction of the set-membership pipeline:
+//  - a constraint-generation round that the solver fails on falls back to the last solved round's bound
+//    (valid for the full set, reported not tight) instead of failing the job;
+//  - the verified LP bound of one variable is a valid bound;
+//  - box contraction keeps the truth inside every interval and in its orthant's contracted box, and never
+//    widens an interval.
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <fmt/format.h>
+
+#include <gtest/gtest.h>
+
+#include "core/cerone_example.hpp"
+#include "relax/basis.hpp"
+#include "relax/constraint_generation.hpp"
+#include "relax/set_membership.hpp"
+
+namespace hw::relax {
+namespace {
+
+// Solves its first `good` problems with CSDP, then reports numerical trouble (a backend giving up mid-run).
+class FailsAfter : public sdp::SdpSolver {
+ public:
+  explicit FailsAfter(int good) : good_(good), inner_(sdp::MakeSolver("csdp")) {}
+  std::string name() const override { return "fails-after"; }
+  sdp::SdpSummary Solve(const sdp::SdpOptions& options, const sdp::LmiProblem& problem) override {
+    if (calls_++ < good_) return inner_->Solve(options, problem);
+    sdp::SdpSummary s;
+    s.status = sdp::SdpStatus::kNumericalTrouble;
+    s.message = "injected failure";
+    s.solver = name();
+    return s;
+  }
+
+ private:
+  int good_, calls_ = 0;
+  std::unique_ptr<sdp::SdpSolver> inner_;
+};
+
+// min x1 in [-1, 1]^2 with candidates x1 >= 0.5 (active) and x2 <= 0.9 (inactive).
+PolyProblem Core() {
+  PolyProblem p;
+  p.num_vars = 2;
+  p.objective = Polynomial::Variable(2, 0);
+  for (int i = 0; i < 2; ++i)
+    p.inequalities.push_back(Polynomial::Constant(2, 1.0) - Polynomial::Variable(2, i) * Polynomial::Variable(2, i));
+  return p;
+}
+std::vector<Polynomial> Candidates() {
+  return {Polynomial::Variable(2, 0) - Polynomial::Constant(2, 0.5),
+          Polynomial::Constant(2, 0.9) - Polynomial::Variable(2, 1)};
+}
+
+TEST(ConstraintGeneration, AFailedRoundFallsBackToTheLastSolvedRound) {
+  ConstraintGenerationOptions o;
+  o.order = 1;
+  o.add_per_round = 1;
+  // Reference: the full run needs a second round and reaches 0.5.
+  auto csdp = sdp::MakeSolver("csdp");
+  const auto full = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, *csdp);
+  ASSERT_EQ(full.status, RelaxationStatus::kSolved) << full.message;
+  ASSERT_GE(full.rounds, 2);
+  EXPECT_NEAR(full.bound, 0.5, 1e-5);
+  EXPECT_TRUE(full.tight);
+  // Round 2 fails: the round-1 bound (the box, -1) is reported, valid, not tight, and verified.
+  FailsAfter failing(1);
+  const auto r = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, failing);
+  ASSERT_EQ(r.status, RelaxationStatus::kSolved) << r.message;
+  EXPECT_FALSE(r.tight);
+  EXPECT_NEAR(r.bound, -1.0, 1e-5);
+  EXPECT_LE(r.bound, full.bound + 1e-9);
+  EXPECT_TRUE(r.verification.verified()) << r.verification.message;
+  EXPECT_NE(r.message.find("last solved round"), std::string::npos) << r.message;
+  // A failure in the first round has nothing to fall back to: the job fails.
+  FailsAfter always(0);
+  const auto none = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, always);
+  EXPECT_EQ(none.status, RelaxationStatus::kSolverFailed);
+}
+
+TEST(LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
+  auto solver = sdp::MakeSolver("csdp");
+  // x1 >= 0.5 and x1 + x2 <= 0.2 inside [-1, 1]^2: x1 in [0.5, 1], x2 <= -0.3.
+  std::vector<Polynomial> cons = {Polynomial::Variable(2, 0) - Polynomial::Constant(2, 0.5),
+                                  Polynomial::Constant(2, 0.2) - Polynomial::Variable(2, 0) - Polynomial::Variable(2, 1)};
+  const auto lo = LinearProgramBound(cons, 2, 0, -1, {}, *solver);
+  ASSERT_EQ(lo.status, LinearProgramBoundResult::kBounded) << lo.summary_message;
+  EXPECT_LE(lo.bound, 0.5);
+  EXPECT_NEAR(lo.bound, 0.5, 1e-6);
+  const auto hi = LinearProgramBound(cons, 2, 1, +1, {}, *solver);
+  ASSERT_EQ(hi.status, LinearProgramBoundResult::kBounded) << hi.summary_message;
+  EXPECT_GE(hi.bound, -0.3);
+  EXPECT_NEAR(hi.bound, -0.3, 1e-6);
+  cons.push_back(Polynomial::Constant(2, -0.8) - Polynomial::Variable(2, 0));  // x1 <= -0.8: empty
+  EXPECT_EQ(LinearProgramBound(cons, 2, 0, -1, {}, *solver).status, LinearProgramBoundResult::kEmpty);
+}
+
+// A small Hammerstein-Wiener system that keeps the test fast: x = u, z_t = -a1 z_{t-1} + b1 x_{t-1},
+// z = w + alpha2 w^2; parameters (alpha2, a1, b1) = (0.3, -0.5, 1.2); u uniform in [0, 1], |eta| <= 0.01.
+const std::vector<double> kTruth = {0.3, -0.5, 1.2};
+
+HwOuterSet SmallSet(int samples) {
+  HwStructure s;
+  s.input_basis = parse_basis("poly:1");
+  s.output_basis = parse_basis("poly:2");
+  s.na = 1;
+  s.nb = 1;
+  s.strictly_proper = true;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), noise(-0.01, 0.01);
+  HwData d;
+  d.source = "small";
+  double z = 0.0, x_prev = 0.0;
+  for (int t = 0; t < samples; ++t) {
+    z = -kTruth[1] * z + kTruth[2] * x_prev;
+    const double w = (-1.0 + std::sqrt(1.0 + 4.0 * kTruth[0] * z)) / (2.0 * kTruth[0]);  // z = w + 0.3 w^2, z >= 0
+    const double u = unit(rng);
+    d.u.push_back(u);
+    d.y.push_back(w + noise(rng));
+    d.noise_bound.push_back(0.01);
+    x_prev = u;
+  }
+  return HwOuterSet(s, d, 2, std::vector<std::pair<double, double>>(3, {-5.0, 5.0}));
+}
+
+BoundsSummary RunSmall(int contraction_passes) {
+  BoundsOptions options;
+  options.order = 2;
+  options.solver = "csdp";
+  options.threads = 2;
+  options.retry_with_other_solver = false;
+  options.contraction_passes = contraction_passes;
+  options.contraction_max_rounds = 2;
+  return ComputeBounds(options, SmallSet(40));
+}
+
+TEST(BoxContraction, KeepsTheTruthAndNeverWidensAnInterval) {
+  const auto plain = RunSmall(0);
+  const auto contracted = RunSmall(2);
+  ASSERT_EQ(plain.intervals.size(), 3u);
+  ASSERT_EQ(contracted.intervals.size(), 3u);
+  EXPECT_TRUE(plain.orthant_boxes.empty());
+  ASSERT_FALSE(contracted.orthant_boxes.empty());
+  EXPECT_GE(contracted.contraction_passes_run, 1);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& p = plain.intervals[k];
+    const auto& c = contracted.intervals[k];
+    SCOPED_TRACE(p.name);
+    EXPECT_LE(p.lower.value, kTruth[k]);
+    EXPECT_GE(p.upper.value, kTruth[k]);
+    EXPECT_LE(c.lower.value, kTruth[k]);
+    EXPECT_GE(c.upper.value, kTruth[k]);
+    // A smaller box gives a tighter (or equal) relaxation; 1e-6 for solver accuracy.
+    if (p.lower.status == "guaranteed" && c.lower.status == "guaranteed") EXPECT_GE(c.lower.value, p.lower.value - 1e-6);
+    if (p.upper.status == "guaranteed" && c.upper.status == "guaranteed") EXPECT_LE(c.upper.value, p.upper.value + 1e-6);
+    // The data pin every parameter well inside the prior box, so the contraction must have moved.
+    EXPECT_LT(c.half_width(), 2.5);
+  }
+  // Every contracted box lies in the prior box, and the truth's orthant box contains the truth.
+  const int truth_orthant = SmallSet(40).orthant_of(kTruth);
+  bool saw_truth_orthant = false;
+  for (const auto& [l, box] : contracted.orthant_boxes) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_GE(box[k].first, -5.0);
+      EXPECT_LE(box[k].second, 5.0);
+      if (l == truth_orthant) {
+        EXPECT_LE(box[k].first, kTruth[k]) << "orthant " << l << " parameter " << k;
+        EXPECT_GE(box[k].second, kTruth[k]) << "orthant " << l << " parameter " << k;
+      }
+    }
+    saw_truth_orthant = saw_truth_orthant || l == truth_orthant;
+  }
+  EXPECT_TRUE(saw_truth_orthant);
+  for (const auto& iv : contracted.intervals)
+    fmt::print("{}: plain [{:.6f}, {:.6f}], contracted [{:.6f}, {:.6f}]\n", iv.name,
+               plain.intervals[&iv - &contracted.intervals[0]].lower.value,
+               plain.intervals[&iv - &contracted.intervals[0]].upper.value, iv.lower.value, iv.upper.value);
+}
+
+}  // namespace
+}  // namespace hw::relax
