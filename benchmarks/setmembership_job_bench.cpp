@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   std::string param = "a1", solver_name = "sdpa";
   bool maximize = false, verify = false;
   int contract_rounds = 0;
+  bool keep_prior_box = false;
   double box = 10.0;
   std::vector<double> box_list;
   app.add_option("--samples", samples);
@@ -38,6 +39,9 @@ int main(int argc, char** argv) {
   app.add_option("--box-list", box_list, "lo1,hi1,...,lo8,hi8: a box per parameter (overrides --box)")
       ->delimiter(',');
   app.add_flag("--verify", verify);
+  app.add_flag("--keep-prior-box", keep_prior_box,
+               "scale variables by --box-list but constrain them by the prior box --box only (an affine change of "
+               "variables: the same relaxation, other conditioning)");
   app.add_option("--lp-contract", contract_rounds, "rounds of LP box contraction in the orthant before the job");
   CLI11_PARSE(app, argc, argv);
 
@@ -80,6 +84,17 @@ int main(int argc, char** argv) {
   core.objective = hw::Polynomial::Variable(core.num_vars, k);
   core.maximize = maximize;
   core.inequalities = set.box_constraints();
+  if (keep_prior_box) {
+    core.inequalities.clear();
+    const auto sub = set.scaling().substitution();
+    for (int i = 0; i < core.num_vars; ++i) {
+      hw::Polynomial g = (sub[i] + hw::Polynomial::Constant(core.num_vars, box)) *
+                         (hw::Polynomial::Constant(core.num_vars, box) - sub[i]);
+      double big = 0.0;
+      for (const auto& [e, c] : g.terms()) big = std::max(big, std::abs(c));
+      core.inequalities.push_back(g * (1.0 / big));
+    }
+  }
   for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(g);
   hw::relax::ConstraintGenerationOptions gen;
   gen.order = order;

@@ -101,12 +101,7 @@ TEST(LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
 const std::vector<double> kTruth = {0.3, -0.5, 1.2};
 
 HwOuterSet SmallSet(int samples) {
-  HwStructure s;
-  s.input_basis = parse_basis("poly:1");
-  s.output_basis = parse_basis("poly:2");
-  s.na = 1;
-  s.nb = 1;
-  s.strictly_proper = true;
+  const HwStructure s{parse_basis("poly:1"), parse_basis("poly:2"), /*na=*/1, /*nb=*/1, /*strictly_proper=*/true};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0), noise(-0.01, 0.01);
   HwData d;
