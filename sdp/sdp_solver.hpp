@@ -28,6 +28,10 @@ struct SdpOptions {
   // sum_i |F_i . X| <= infeasibility_tolerance * F_0 . X (then sum y_i F_i - F_0 >= 0 is impossible for
   // |y_i| <= 1 / infeasibility_tolerance). Backends' own phase labels are not trusted alone.
   double infeasibility_tolerance = 1e-4;
+  // SDPA only: a solve that ends undecided with SDPA's stable parameter set is repeated with its default set
+  // (small POPs that stopped at pdFEAS/dFEAS finish that way). Callers with their own fallback chain turn it
+  // off: on large ill-conditioned LMIs the second attempt mostly fails too and doubles the cost.
+  bool retry_with_default_parameters = true;
   bool IsValid(std::string* error) const;
 };
 

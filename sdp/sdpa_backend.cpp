@@ -169,7 +169,7 @@ SdpSummary SdpaSolver::Solve(const SdpOptions& options, const LmiProblem& proble
       return s.status == SdpStatus::kOptimal || s.status == SdpStatus::kInfeasible || s.status == SdpStatus::kUnbounded;
     };
     SdpSummary first = SolveWithSdpa(options, p, SDPA::PARAMETER_STABLE_BUT_SLOW);
-    if (decided(first)) return first;
+    if (decided(first) || !options.retry_with_default_parameters) return first;
     SdpSummary second = SolveWithSdpa(options, p, SDPA::PARAMETER_DEFAULT);
     second.setup_seconds += first.setup_seconds + first.solve_seconds;  // the time of both attempts counts
     second.iterations += first.iterations;
