@@ -191,8 +191,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
   // Endpoints come from the dual side, whose validity needs dual feasibility, not a small gap: accept
   // near-optimal stops up to 1e-5 (the gap costs at most that much tightness on the scaled parameters).
   opts.generation.sdp.acceptable_gap = std::max(opts.generation.sdp.acceptable_gap, 1e-5);
-  // The engine's own fallbacks (the other backend, then the last solved round) follow a failed round; a second
-  // SDPA attempt first made the bundled example about 4x slower (419 s -> over 1600 s, measured).
+  // The engine's own fallbacks (the other backend, then the last solved round) follow a failed round, so a
+  // second SDPA attempt with other parameters would only add a full solve to each failing round.
   opts.generation.sdp.retry_with_default_parameters = false;
   const auto t0 = Clock::now();
   const int n = set.num_vars();
