@@ -98,8 +98,7 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     result.num_blocks = relaxation.lmi().blocks.size();
     auto sdp = solver.Solve(sdp_options, relaxation.lmi());
     sdp::SdpSolver* used = &solver;
-    if (fallback && sdp.status != sdp::SdpStatus::kOptimal && sdp.status != sdp::SdpStatus::kInfeasible &&
-        sdp.status != sdp::SdpStatus::kUnbounded) {
+    if (fallback && !sdp.decided()) {
       const std::string first = sdp.message;
       result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
       sdp = fallback->Solve(sdp_options, relaxation.lmi());

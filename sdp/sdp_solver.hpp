@@ -66,6 +66,10 @@ struct SdpSummary {
 
   // True only when status is kOptimal: a bound read from any other outcome is never reported as valid.
   bool usable() const { return status == SdpStatus::kOptimal; }
+  // The solve settled the problem (optimal, or certified infeasible/unbounded); anything else is worth a retry.
+  bool decided() const {
+    return status == SdpStatus::kOptimal || status == SdpStatus::kInfeasible || status == SdpStatus::kUnbounded;
+  }
 };
 
 // Solve() may be called from several threads at once (each call owns its data), but both libraries keep

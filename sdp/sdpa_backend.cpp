@@ -165,15 +165,12 @@ SdpSummary SdpaSolver::Solve(const SdpOptions& options, const LmiProblem& proble
   // solve that ends neither optimal nor with a certified infeasible/unbounded outcome is repeated with SDPA's
   // default parameter set; the first decided outcome wins, otherwise the first attempt is returned.
   return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) {
-    auto decided = [](const SdpSummary& s) {
-      return s.status == SdpStatus::kOptimal || s.status == SdpStatus::kInfeasible || s.status == SdpStatus::kUnbounded;
-    };
     SdpSummary first = SolveWithSdpa(options, p, SDPA::PARAMETER_STABLE_BUT_SLOW);
-    if (decided(first) || !options.retry_with_default_parameters) return first;
+    if (first.decided() || !options.retry_with_default_parameters) return first;
     SdpSummary second = SolveWithSdpa(options, p, SDPA::PARAMETER_DEFAULT);
     second.setup_seconds += first.setup_seconds + first.solve_seconds;  // the time of both attempts counts
     second.iterations += first.iterations;
-    if (decided(second)) {
+    if (second.decided()) {
       second.message += " [after " + first.message + "]";
       return second;
     }
