@@ -10,6 +10,7 @@
 
 #include "core/cerone_example.hpp"
 #include "relax/constraint_generation.hpp"
+#include "relax/moment_lp.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "sdp/sdp_solver.hpp"
 
@@ -109,8 +110,8 @@ int main(int argc, char** argv) {
   const auto t0 = Clock::now();
   int round = 0;
   const auto r = hw::relax::SolveWithConstraintGeneration(
-      gen, core, candidates, {}, *solver, [&](const std::vector<int>& ws) {
-        fmt::print("{:>5} {:>5} {:>9.2f}\n", ++round, ws.size(), since(t0));
+      gen, core, candidates, {}, *solver, [&](const hw::relax::GenerationRound& r) {
+        fmt::print("{:>5} {:>5} {:>9.2f}  {} bound {:.6f}\n", ++round, r.blocks, since(t0), r.status, r.bound);
         std::fflush(stdout);
       });
   fmt::print("status {} bound {:.6f} (original units {:.6f}) tight {} rounds {} iterations {} solver {:.2f} s of "

@@ -135,6 +135,8 @@ void AddBoundsCommand(CLI::App& app) {
     options.contraction_passes = o->contraction_passes;
     options.parameters = o->params;
     options.generation.verify.enabled = o->verify;
+    if (!o->quiet)  // one line per constraint-generation round, printed by the process that runs the job
+      options.round_log = [](const std::string& line) { fmt::print(stderr, "  {}\n", line); };
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
       relax::ComputeBounds(options, set);
       return;
@@ -151,9 +153,12 @@ void AddBoundsCommand(CLI::App& app) {
                o->solver, options.executor->name(), options.executor->workers());
     auto progress = [o](const relax::BoundsProgress& p) {
       if (o->quiet) return;
-      fmt::print(stderr, "\r[{}] {}/{} jobs, elapsed {:.0f} s, ETA {:.0f} s   ", p.phase, p.done, p.total,
+      if (p.total < 0) {  // a one-off message
+        fmt::print(stderr, "{}\n", p.phase);
+        return;
+      }
+      fmt::print(stderr, "[{}] {}/{} jobs, elapsed {:.0f} s, ETA {:.0f} s\n", p.phase, p.done, p.total,
                  p.elapsed_seconds, p.eta_seconds);
-      if (p.done == p.total) fmt::print(stderr, "\n");
     };
     const auto summary = relax::ComputeBounds(options, set, progress);
     fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {:<10} {:>19}  {}\n", "parameter", "lower", "upper", "half-width",
@@ -190,6 +195,21 @@ void AddBoundsCommand(CLI::App& app) {
                summary.orthants_total, summary.orthants_empty, summary.orthants_solved, summary.orthants_failed,
                summary.sdp_jobs, summary.sdp_solves, summary.jobs_from_cache, summary.largest_moments,
                summary.largest_blocks, summary.median_solve_seconds, summary.wall_seconds);
+    for (const auto& r : summary.row_reduction) {
+      std::string steps;
+      for (const auto& c : r.at("per_step"))
+        if (c.contains("step"))
+          steps += fmt::format("{}step {}: {} of {}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
+                               c.at("kept").get<int>(), c.at("rows").get<int>());
+      fmt::print("exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);
+    }
+    if (!summary.bound_sources.empty()) {
+      std::string sources;
+      for (const auto& [what, count] : summary.bound_sources)
+        sources += fmt::format("{}{} {}", sources.empty() ? "" : ", ", count, what);
+      fmt::print("orthant bounds entering the endpoints: {}\n", sources);
+    }
+    if (summary.clipped_to_box) fmt::print("note: endpoints beyond the prior box are intersected with it\n");
     if (!summary.all_guaranteed())
       fmt::print("WARNING: some endpoints are conservative fallbacks (still valid bounds) or floating-point bounds that "
                  "verification could not prove (see notes and the verified column).\n");

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -24,11 +25,78 @@ bool ConstraintGenerationOptions::IsValid(std::string* error) const {
   return sdp.IsValid(error);
 }
 
+std::string ToString(BoundOrigin o) {
+  switch (o) {
+    case BoundOrigin::kNone: return "none";
+    case BoundOrigin::kFinalRound: return "final round";
+    case BoundOrigin::kEarlierRound: return "earlier round";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// The LMI of one round: core inequalities and block candidates at full order, the other candidates (when
+// linear_rows_first) as scalar moment constraints.
+struct RoundRelaxation {
+  PolyProblem problem;
+  std::unique_ptr<MomentRelaxation> relaxation;
+  int linear_rows = 0;
+};
+
+RoundRelaxation BuildRound(const PolyProblem& core, const std::vector<Polynomial>& candidates,
+                           const std::set<int>& blocks, bool linear_rows_first, int order) {
+  RoundRelaxation r;
+  r.problem = core;
+  std::vector<int> orders(core.inequalities.size(), -1);
+  for (int i : blocks) {
+    r.problem.inequalities.push_back(candidates[i]);
+    orders.push_back(-1);
+  }
+  if (linear_rows_first)
+    for (int i = 0; i < static_cast<int>(candidates.size()); ++i)
+      if (!blocks.count(i)) {
+        r.problem.inequalities.push_back(candidates[i]);
+        orders.push_back(0);
+        ++r.linear_rows;
+      }
+  r.relaxation = std::make_unique<MomentRelaxation>(r.problem, order, orders);
+  return r;
+}
+
+// Omitted blocks violated at moments y: (relative violation, candidate), and the largest violation.
+std::pair<std::vector<std::pair<double, int>>, double> ViolatedBlocks(const MomentRelaxation& relaxation,
+                                                                     const std::vector<Polynomial>& candidates,
+                                                                     const std::set<int>& blocks,
+                                                                     const std::vector<double>& y, double tolerance) {
+  std::vector<std::pair<double, int>> violated;
+  double worst = 0.0;
+  for (int i = 0; i < static_cast<int>(candidates.size()); ++i) {
+    if (blocks.count(i)) continue;
+    const Eigen::MatrixXd L = relaxation.localizing_matrix(candidates[i], y);
+    double min_eig;
+    if (L.rows() == 1) {
+      min_eig = L(0, 0);
+    } else {
+      Eigen::LLT<Eigen::MatrixXd> llt(L);
+      if (llt.info() == Eigen::Success) continue;  // positive definite: satisfied
+      min_eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(L, Eigen::EigenvaluesOnly).eigenvalues()(0);
+    }
+    const double rel = -min_eig / std::max(1.0, L.cwiseAbs().maxCoeff());
+    worst = std::max(worst, rel);
+    if (rel > tolerance) violated.push_back({rel, i});
+  }
+  std::sort(violated.rbegin(), violated.rend());
+  return {violated, worst};
+}
+
+}  // namespace
+
 ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerationOptions& options,
                                                          const PolyProblem& core,
                                                          const std::vector<Polynomial>& candidates,
                                                          std::vector<int> initial, sdp::SdpSolver& solver,
-                                                         const std::function<void(const std::vector<int>&)>& on_round,
+                                                         const std::function<void(const GenerationRound&)>& on_round,
                                                          sdp::SdpSolver* fallback) {
   ConstraintGenerationResult result;
   std::string error;
@@ -36,7 +104,7 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     result.message = error;
     return result;
   }
-  std::set<int> working(initial.begin(), initial.end());
+  std::set<int> blocks(initial.begin(), initial.end());
   int order = options.order;
   {
     PolyProblem all = core;
@@ -46,157 +114,170 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
   const bool verify = options.verify.enabled;
   sdp::SdpOptions sdp_options = options.sdp;
   if (verify) sdp_options.keep_dual_matrix = true;
-  // Verifies the bound of the final round (a perturbed re-solve may be needed; intermediate rounds' bounds
-  // are never reported, so they are not verified).
-  auto verify_bound = [&](const PolyProblem& problem, const MomentRelaxation& relaxation, const sdp::SdpSummary& sdp,
-                          sdp::SdpSolver& used) {
-    const double sign = relaxation.objective_sign();
-    result.float_bound = sign * sdp.lower_bound;
-    if (!verify) return;
-    result.verification = sdp::VerifyOptimalSolve(options.verify, sdp_options, relaxation.lmi(),
-                                                  MomentVariableBounds(problem, relaxation), sdp, used);
-    result.verification.float_bound = result.float_bound;
-    if (result.verification.verified()) {
-      result.bound = sign * result.verification.bound;
+
+  // The best valid bound over all rounds (each round relaxes a subset of the inequalities, so each is valid for
+  // the full set). With verification on, a round's bound is the verified bound of its multiplier, whether the
+  // solve converged or not; with verification off only converged rounds count (their floating-point bound).
+  struct BestBound {
+    bool any = false;
+    double value = 0.0, float_value = 0.0, primal = 0.0;  // in the problem's own sign convention
+    int round = 0;
+    bool unfinished = false;
+    sdp::VerifiedBound verification;
+  } best;
+  auto offer = [&](int round, const sdp::SdpSummary& sdp, const sdp::VerifiedBound* v, double sign) {
+    double value;
+    if (verify) {
+      if (!v || !v->verified() || !std::isfinite(v->bound)) return;
+      value = sign * v->bound;
     } else {
-      result.message += "; " + result.verification.message;
+      if (sdp.status != sdp::SdpStatus::kOptimal) return;
+      value = sign * sdp.lower_bound;
     }
+    const bool better = !best.any || (sign > 0 ? value > best.value : value < best.value);
+    if (!better) return;
+    best.any = true;
+    best.value = value;
+    best.float_value = sign * sdp.lower_bound;
+    best.primal = sign * sdp.primal_value;
+    best.round = round;
+    best.unfinished = sdp.status != sdp::SdpStatus::kOptimal;
+    if (v) best.verification = *v;
   };
-  // The last round whose LMI was solved: its bound is valid for the full set too (it relaxes a subset of the
-  // inequalities), so a later round that the solver fails on falls back to it instead of losing it.
-  struct SolvedRound {
-    PolyProblem problem;
-    std::unique_ptr<MomentRelaxation> relaxation;
-    sdp::SdpSummary sdp;
-    sdp::SdpSolver* used = nullptr;
-    std::vector<int> working;
-    double max_violation = 0.0;
-  };
-  std::optional<SolvedRound> last_solved;
-  auto fall_back = [&](const std::string& why) {
-    if (!last_solved) return false;
-    const auto& r = *last_solved;
-    const double sign = r.relaxation->objective_sign();
-    result.status = RelaxationStatus::kSolved;
-    result.tight = false;
-    result.bound = sign * r.sdp.lower_bound;
-    result.primal_value = sign * r.sdp.primal_value;
-    result.max_violation = r.max_violation;
-    result.working_set = r.working;
-    result.message = fmt::format("{}; the bound of the last solved round ({} of {} data constraints) is reported: "
-                                 "valid, possibly looser than the full relaxation's",
-                                 why, r.working.size(), candidates.size());
-    verify_bound(r.problem, *r.relaxation, r.sdp, *r.used);
-    return true;
-  };
-  for (int round = 1; round <= options.max_rounds; ++round) {
-    result.rounds = round;
-    PolyProblem problem = core;
-    for (int i : working) problem.inequalities.push_back(candidates[i]);
-    MomentRelaxation relaxation(problem, order);
-    result.num_moments = relaxation.lmi().c.size();
-    result.num_blocks = relaxation.lmi().blocks.size();
-    auto sdp = solver.Solve(sdp_options, relaxation.lmi());
-    sdp::SdpSolver* used = &solver;
-    if (fallback && !sdp.decided()) {
-      const std::string first = sdp.message;
-      result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
-      sdp = fallback->Solve(sdp_options, relaxation.lmi());
-      sdp.message += " [after " + first + "]";
-      used = fallback;
-    }
-    result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
-    result.sdp_iterations += sdp.iterations;
-    result.working_set.assign(working.begin(), working.end());
-    if (verify && sdp.status == sdp::SdpStatus::kInfeasible) {
-      // An emptiness claim stands only on a verified certificate; the other backend gets one chance to give one.
-      result.verification = sdp::VerifyInfeasibility(relaxation.lmi(), sdp.X, MomentVariableBounds(problem, relaxation));
-      if (!result.verification.verified() && fallback && used != fallback) {
-        auto second = fallback->Solve(sdp_options, relaxation.lmi());
-        result.solve_seconds += second.setup_seconds + second.solve_seconds;
-        if (second.status == sdp::SdpStatus::kInfeasible) {
-          auto v = sdp::VerifyInfeasibility(relaxation.lmi(), second.X, MomentVariableBounds(problem, relaxation));
-          v.seconds += result.verification.seconds;
-          if (v.verified()) sdp = std::move(second);
-          result.verification = v;
-        }
-      }
-      if (!result.verification.verified()) {
-        result.last_sdp = sdp;
-        const std::string why = fmt::format("relaxation reported infeasible, but {}: the set is NOT declared empty",
-                                            result.verification.message);
-        result.verification = {};
-        if (fall_back(why)) return result;
-        result.status = RelaxationStatus::kSolverFailed;
-        result.message = why;
-        return result;
-      }
-    }
-    result.last_sdp = sdp;
-    if (sdp.status == sdp::SdpStatus::kInfeasible) {
-      result.status = RelaxationStatus::kInfeasible;
-      result.message = fmt::format("relaxation with {} of {} data constraints is infeasible: the set is empty",
-                                   working.size(), candidates.size());
-      return result;
-    }
-    if (sdp.status == sdp::SdpStatus::kUnbounded) {
-      result.status = RelaxationStatus::kUnbounded;
-      result.message = "relaxation unbounded: add a box";
-      return result;
-    }
-    if (sdp.status != sdp::SdpStatus::kOptimal) {
-      const std::string why = fmt::format("round {}: {}: {} ({})", round, sdp.solver, sdp::ToString(sdp.status),
-                                          sdp.message);
-      if (fall_back(why)) return result;
+  // Ends the job with the best bound found (or as failed when there is none).
+  auto finish = [&](bool converged_final_round, const std::string& why) {
+    if (!best.any) {
       result.status = RelaxationStatus::kSolverFailed;
       result.message = why;
       return result;
     }
-    const double sign = relaxation.objective_sign();
     result.status = RelaxationStatus::kSolved;
-    result.bound = sign * sdp.lower_bound;
-    result.primal_value = sign * sdp.primal_value;
+    result.bound = best.value;
+    result.float_bound = best.float_value;
+    result.primal_value = best.primal;
+    result.verification = best.verification;
+    result.bound_round = best.round;
+    result.bound_from_unfinished_solve = best.unfinished;
+    result.origin = best.round == result.rounds ? BoundOrigin::kFinalRound : BoundOrigin::kEarlierRound;
+    result.tight = converged_final_round;
+    result.message = why;
+    if (result.origin == BoundOrigin::kEarlierRound)
+      result.message += fmt::format("; the bound of round {} is reported (valid: it relaxes a subset of the "
+                                    "inequalities)", best.round);
+    if (best.unfinished) result.message += "; from the verified last iterate of a solve that stopped short";
+    return result;
+  };
+
+  std::vector<double> warm_y;
+  for (int round = 1; round <= options.max_rounds; ++round) {
+    result.rounds = round;
+    GenerationRound report;
+    report.round = round;
+    RoundRelaxation built = BuildRound(core, candidates, blocks, options.linear_rows_first, order);
+    const MomentRelaxation& relaxation = *built.relaxation;
+    report.blocks = static_cast<int>(blocks.size());
+    report.linear_rows = built.linear_rows;
+    result.num_moments = relaxation.lmi().c.size();
+    result.num_blocks = relaxation.lmi().blocks.size();
+    sdp::SdpOptions round_options = sdp_options;
+    if (options.warm_start && warm_y.size() == relaxation.lmi().c.size()) round_options.initial_y = warm_y;
+    auto sdp = solver.Solve(round_options, relaxation.lmi());
+    sdp::SdpSolver* used = &solver;
+    if (fallback && !sdp.decided()) {
+      const std::string first = sdp.message;
+      result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
+      auto second = fallback->Solve(sdp_options, relaxation.lmi());
+      second.message += " [after " + first + "]";
+      // Keep the first attempt's iterate too: both multipliers are verified below when the second also fails.
+      if (second.decided() || second.X.size() == relaxation.lmi().blocks.size()) {
+        sdp = std::move(second);
+        used = fallback;
+      }
+    }
+    result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
+    result.sdp_iterations += sdp.iterations;
+    report.seconds = sdp.setup_seconds + sdp.solve_seconds;
+    report.status = sdp::ToString(sdp.status);
+    result.working_set.assign(blocks.begin(), blocks.end());
+    result.last_sdp = sdp;
+    const double sign = relaxation.objective_sign();
+    const auto bounds = MomentVariableBounds(built.problem, relaxation);
+    auto announce = [&](int violated) {
+      report.violated = violated;
+      report.bound = best.any ? best.value : NAN;
+      report.bound_verified = verify && best.any;
+      result.history.push_back(report);
+      if (on_round) on_round(report);
+    };
+
+    if (sdp.status == sdp::SdpStatus::kInfeasible) {
+      // An emptiness claim stands only on a verified certificate; the other backend gets one chance to give one.
+      sdp::VerifiedBound cert;
+      if (verify) {
+        cert = sdp::VerifyInfeasibility(relaxation.lmi(), sdp.X, bounds);
+        if (!cert.verified() && fallback && used != fallback) {
+          auto second = fallback->Solve(sdp_options, relaxation.lmi());
+          result.solve_seconds += second.setup_seconds + second.solve_seconds;
+          if (second.status == sdp::SdpStatus::kInfeasible) {
+            auto v = sdp::VerifyInfeasibility(relaxation.lmi(), second.X, bounds);
+            v.seconds += cert.seconds;
+            cert = v;
+          }
+        }
+      }
+      announce(-1);
+      if (!verify || cert.verified()) {
+        result.status = RelaxationStatus::kInfeasible;
+        result.verification = cert;
+        result.message = fmt::format("relaxation with {} of {} data constraints as blocks is infeasible: the set is "
+                                     "empty", blocks.size(), candidates.size());
+        return result;
+      }
+      return finish(false, fmt::format("relaxation reported infeasible, but {}: the set is NOT declared empty",
+                                       cert.message));
+    }
+    if (sdp.status == sdp::SdpStatus::kUnbounded) {
+      announce(-1);
+      result.status = RelaxationStatus::kUnbounded;
+      result.message = "relaxation unbounded: add a box";
+      return result;
+    }
+
+    // Every round's multiplier gives a rigorous bound, converged or not.
+    if (verify && sdp.X.size() == relaxation.lmi().blocks.size()) {
+      auto v = sdp::VerifyMultiplier(relaxation.lmi(), sdp.X, bounds, sdp.lower_bound,
+                                     options.verify.acceptable_correction);
+      offer(round, sdp, &v, sign);
+    } else {
+      offer(round, sdp, nullptr, sign);
+    }
+    if (sdp.status != sdp::SdpStatus::kOptimal) {
+      announce(-1);
+      return finish(false, fmt::format("round {}: {}: {} ({})", round, sdp.solver, sdp::ToString(sdp.status),
+                                       sdp.message));
+    }
+    warm_y = sdp.y;
+    result.last_y = sdp.y;
     const auto y = relaxation.moments(sdp.y);
     result.first_moments.assign(y.begin() + 1, y.begin() + 1 + core.num_vars);
-
-    // Check every omitted candidate at the returned moments.
-    std::vector<std::pair<double, int>> violated;
-    double worst = 0.0;
-    for (int i = 0; i < static_cast<int>(candidates.size()); ++i) {
-      if (working.count(i)) continue;
-      const Eigen::MatrixXd L = relaxation.localizing_matrix(candidates[i], y);
-      double min_eig;
-      if (L.rows() == 1) {
-        min_eig = L(0, 0);
-      } else {
-        Eigen::LLT<Eigen::MatrixXd> llt(L);
-        if (llt.info() == Eigen::Success) continue;  // positive definite: satisfied
-        min_eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(L, Eigen::EigenvaluesOnly).eigenvalues()(0);
-      }
-      const double rel = -min_eig / std::max(1.0, L.cwiseAbs().maxCoeff());
-      worst = std::max(worst, rel);
-      if (rel > options.violation_tolerance) violated.push_back({rel, i});
-    }
+    const auto [violated, worst] = ViolatedBlocks(relaxation, candidates, blocks, y, options.violation_tolerance);
     result.max_violation = worst;
-    if (on_round) on_round(result.working_set);
-    if (violated.empty()) {
-      result.tight = true;
-      result.message = fmt::format("tight: {} rounds, {} of {} data constraints in the LMI, none of the others violated",
-                                   round, working.size(), candidates.size());
-      verify_bound(problem, relaxation, sdp, *used);
-      return result;
+    const bool converged = violated.empty();
+    if (converged || round == options.max_rounds) {
+      // The bound that is reported: verify the final round with re-solves when the plain check was loose.
+      if (verify) {
+        auto v = sdp::VerifyOptimalSolve(options.verify, sdp_options, relaxation.lmi(), bounds, sdp, *used);
+        offer(round, sdp, &v, sign);
+      }
+      announce(static_cast<int>(violated.size()));
+      if (converged)
+        return finish(true, fmt::format("tight: {} rounds, {} of {} data constraints as blocks, none of the others "
+                                        "violated", round, blocks.size(), candidates.size()));
+      return finish(false, fmt::format("round limit reached: the bound is valid but may be looser than the full "
+                                       "relaxation's (max relative violation {:.2e})", worst));
     }
-    if (round == options.max_rounds) {
-      result.message = fmt::format("round limit reached: the bound is valid but may be looser than the full "
-                                   "relaxation's (max relative violation {:.2e})",
-                                   result.max_violation);
-      verify_bound(problem, relaxation, sdp, *used);
-      return result;
-    }
-    last_solved = SolvedRound{problem, std::make_unique<MomentRelaxation>(std::move(relaxation)), sdp, used,
-                              result.working_set, result.max_violation};
-    std::sort(violated.rbegin(), violated.rend());
-    for (int k = 0; k < std::min<int>(options.add_per_round, violated.size()); ++k) working.insert(violated[k].second);
+    announce(static_cast<int>(violated.size()));
+    for (int k = 0; k < std::min<int>(options.add_per_round, violated.size()); ++k) blocks.insert(violated[k].second);
   }
   return result;
 }
@@ -242,125 +323,6 @@ sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const Momen
       out.lower[single[k]] = -1.0;
       out.upper[single[k]] = 1.0;
     }
-  return out;
-}
-
-namespace {
-
-// The LP of ScreenWithLinearProgram / LinearProgramBound: every monomial of degree <= D a free variable y with
-// |y| <= 1 and y >= 0 for even monomials; one row per constraint.
-struct MomentLp {
-  sdp::LmiProblem lp;
-  MonomialBasis basis;
-};
-
-MomentLp BuildMomentLp(const std::vector<Polynomial>& constraints, int num_vars) {
-  int D = 1;
-  for (const auto& g : constraints) D = std::max(D, g.degree());
-  MomentLp out{sdp::LmiProblem{}, MonomialBasis(num_vars, D)};
-  const MonomialBasis& basis = out.basis;
-  const int m = static_cast<int>(basis.size()) - 1;
-  std::vector<int> even;
-  for (int i = 1; i <= m; ++i) {
-    bool all_even = true;
-    for (auto e : basis[i]) all_even = all_even && e % 2 == 0;
-    if (all_even) even.push_back(i);
-  }
-  const int rows = static_cast<int>(constraints.size()) + 2 * m + static_cast<int>(even.size());
-  sdp::LmiProblem& lp = out.lp;
-  lp.blocks.push_back({sdp::BlockSpec::Kind::kDiagonal, rows});
-  lp.c.assign(m, 0.0);  // feasibility problem unless the caller sets an objective
-  lp.F.assign(m + 1, {});
-  int r = 0;
-  for (const auto& g : constraints) {
-    for (const auto& [e, coef] : g.terms()) {
-      const long k = basis.index_of(e);
-      if (k == 0)
-        lp.F[0].push_back({0, r, r, -coef});
-      else
-        lp.F[k].push_back({0, r, r, coef});
-    }
-    ++r;
-  }
-  for (int k = 1; k <= m; ++k) {  // 1 - y >= 0 and 1 + y >= 0
-    lp.F[0].push_back({0, r, r, -1.0});
-    lp.F[k].push_back({0, r, r, -1.0});
-    ++r;
-    lp.F[0].push_back({0, r, r, -1.0});
-    lp.F[k].push_back({0, r, r, 1.0});
-    ++r;
-  }
-  for (int k : even) {
-    lp.F[k].push_back({0, r, r, 1.0});
-    ++r;
-  }
-  return out;
-}
-
-// Keeps an infeasibility claim of the LP only with a verified certificate (|y| <= 1 is part of the LP).
-void CertifyLpInfeasibility(const sdp::LmiProblem& lp, sdp::SdpSummary& s, sdp::VerifiedBound* certificate) {
-  if (s.status != sdp::SdpStatus::kInfeasible) return;
-  *certificate = sdp::VerifyInfeasibility(lp, s.X, sdp::VariableBounds::Uniform(lp.num_vars(), -1.0, 1.0));
-  if (!certificate->verified()) {
-    s.status = sdp::SdpStatus::kNumericalTrouble;
-    s.message += "; " + certificate->message;
-  }
-}
-
-}  // namespace
-
-sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constraints, int num_vars,
-                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver,
-                                        sdp::VerifiedBound* certificate) {
-  const MomentLp built = BuildMomentLp(constraints, num_vars);
-  if (!certificate) return solver.Solve(options, built.lp);
-  sdp::SdpOptions keep = options;
-  keep.keep_dual_matrix = true;
-  auto s = solver.Solve(keep, built.lp);
-  CertifyLpInfeasibility(built.lp, s, certificate);
-  if (!options.keep_dual_matrix) {
-    s.X.clear();
-    s.Z.clear();
-  }
-  return s;
-}
-
-LinearProgramBoundResult LinearProgramBound(const std::vector<Polynomial>& constraints, int num_vars, int variable,
-                                            int direction, const sdp::SdpOptions& options, sdp::SdpSolver& solver) {
-  LinearProgramBoundResult out;
-  MomentLp built = BuildMomentLp(constraints, num_vars);
-  Exponents e(num_vars, 0);
-  e[variable] = 1;
-  const long k = built.basis.index_of(e);
-  // The LP minimises: min x_k, or min -x_k for the maximum.
-  built.lp.c[k - 1] = direction < 0 ? 1.0 : -1.0;
-  sdp::SdpOptions keep = options;
-  keep.keep_dual_matrix = true;
-  auto s = solver.Solve(keep, built.lp);
-  out.summary_message = s.message;
-  if (s.status == sdp::SdpStatus::kInfeasible) {
-    sdp::VerifiedBound cert;
-    CertifyLpInfeasibility(built.lp, s, &cert);
-    out.status = s.status == sdp::SdpStatus::kInfeasible ? LinearProgramBoundResult::kEmpty
-                                                          : LinearProgramBoundResult::kFailed;
-    return out;
-  }
-  if (s.status != sdp::SdpStatus::kOptimal && s.status != sdp::SdpStatus::kInaccurate &&
-      s.status != sdp::SdpStatus::kIterationLimit) {
-    out.status = LinearProgramBoundResult::kFailed;
-    return out;
-  }
-  // Any multiplier X gives a rigorous bound (weak duality with |y| <= 1), optimal or not: verify it, and use
-  // the box edge when the verified value is not finite.
-  const auto v = sdp::VerifyLowerBound(built.lp, s.X, sdp::VariableBounds::Uniform(built.lp.num_vars(), -1.0, 1.0),
-                                       s.lower_bound);
-  if (!v.verified() || !std::isfinite(v.bound)) {
-    out.status = LinearProgramBoundResult::kFailed;
-    out.summary_message += "; " + v.message;
-    return out;
-  }
-  out.status = LinearProgramBoundResult::kBounded;
-  out.bound = std::clamp(direction < 0 ? v.bound : -v.bound, -1.0, 1.0);
   return out;
 }
 

@@ -6,6 +6,7 @@
 // localizing constraint (PSD within tolerance), they are feasible for the full relaxation and the bound
 // equals the full relaxation's bound. Otherwise the most violated constraints join the working set and
 // the relaxation is solved again. Infeasibility of a subset proves infeasibility of the full set.
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -18,42 +19,71 @@ namespace hw::relax {
 struct ConstraintGenerationOptions {
   int order = 0;                    // 0 = minimal
   int max_rounds = 40;
-  int add_per_round = 20;           // most violated constraints added per round
+  int add_per_round = 20;           // most violated constraints promoted to a block per round
   double violation_tolerance = 1e-6;  // min eigenvalue below -tol * max(1, ||L||) counts as violated
+  // Every candidate without a block enters the LMI as the scalar moment constraint L_y(g) >= 0 (its localizing
+  // matrix of order 0): implied by its block, so valid, and cheap (one row of the LP block). A candidate gets
+  // its full localizing block when that block is violated at the current moments.
+  bool linear_rows_first = true;
+  // Pass the previous round's moments to backends that take an initial point (SdpOptions::initial_y).
+  bool warm_start = true;
   sdp::SdpOptions sdp;
-  // Verification of the final round (sdp/verified_bound.hpp): the reported bound becomes the verified one, and
-  // an infeasibility certificate that does not verify makes the job fail instead of declaring the set empty.
+  // Verification (sdp/verified_bound.hpp): every round's multiplier gives a rigorous bound, the final round's
+  // with re-solves when needed; an infeasibility certificate that does not verify never declares the set empty.
   sdp::VerifyOptions verify;
   bool IsValid(std::string* error) const;
 };
+
+// What one round did, for progress lines and reports.
+struct GenerationRound {
+  int round = 0;
+  int blocks = 0;           // candidates with their full localizing block in this round's LMI
+  int linear_rows = 0;      // candidates as scalar moment constraints
+  std::string status;       // the solve's SdpStatus
+  double bound = NAN;       // the best valid bound so far (NaN: none yet), same sign convention as the result
+  bool bound_verified = false;
+  int violated = 0;         // omitted blocks violated at this round's moments (-1: not checked)
+  double seconds = 0.0;
+};
+
+// Where a job's bound came from: the converged (or round-limited) final round, or an earlier round whose
+// relaxation of a subset is valid for the full set.
+enum class BoundOrigin { kNone, kFinalRound, kEarlierRound };
+std::string ToString(BoundOrigin o);
 
 struct ConstraintGenerationResult {
   RelaxationStatus status = RelaxationStatus::kInvalid;
   std::string message;
   double bound = 0.0;        // valid bound of the optimum (lower for min, upper for max) when kSolved
                              // (the verified bound when verification.verified(), else the floating-point one)
-  double float_bound = 0.0;  // the solver's floating-point bound (same sign convention)
-  sdp::VerifiedBound verification;  // of the final round (lower-bound or infeasibility certificate)
+  double float_bound = 0.0;  // the solver's floating-point bound of the round the bound comes from
+  sdp::VerifiedBound verification;  // of the round the bound comes from (lower-bound or infeasibility certificate)
+  BoundOrigin origin = BoundOrigin::kNone;
+  int bound_round = 0;       // the round whose multiplier gave the bound
+  bool bound_from_unfinished_solve = false;  // that round's solve stopped short (pFEAS, iteration limit, ...)
   double primal_value = 0.0;
-  bool tight = false;        // true: no omitted constraint is violated, so bound == full relaxation's bound
-  double max_violation = 0.0;  // largest relative violation among omitted constraints at the last round
+  bool tight = false;        // true: no omitted block is violated, so bound == full relaxation's bound
+  double max_violation = 0.0;  // largest relative violation among omitted blocks at the last checked round
   int rounds = 0;
-  std::vector<int> working_set;  // candidate indices used in the last LMI
+  std::vector<int> working_set;  // candidates with a block in the last LMI
   std::vector<double> first_moments;
+  std::vector<double> last_y;    // the last solved round's LMI variables (a warm start for a next job)
   std::size_t num_moments = 0, num_blocks = 0;
   double solve_seconds = 0.0;  // total SDP time over rounds
   int sdp_iterations = 0;
   sdp::SdpSummary last_sdp;
+  std::vector<GenerationRound> history;
 };
 
-// `core` inequalities are always in the LMI; `candidates` enter on demand, starting from `initial`.
-// `on_round` (optional) sees the working set after each round (for resumable runs). When the solver fails on
-// a round's LMI (neither optimal nor a certified infeasible/unbounded outcome), `fallback` (optional, e.g. the
-// other backend) solves the same LMI before the round is declared failed.
+// `core` inequalities are always in the LMI with full blocks; `candidates` get blocks on demand, starting
+// from `initial`. `on_round` (optional) sees each round as it ends (progress lines). When the solver fails on a
+// round's LMI (neither optimal nor a certified infeasible/unbounded outcome), `fallback` (optional, e.g. the
+// other backend) solves the same LMI before the round counts as failed. A failed round ends the job with the
+// best verified bound of all its rounds (its own last iterate included).
 ConstraintGenerationResult SolveWithConstraintGeneration(
     const ConstraintGenerationOptions& options, const PolyProblem& core, const std::vector<Polynomial>& candidates,
     std::vector<int> initial, sdp::SdpSolver& solver,
-    const std::function<void(const std::vector<int>&)>& on_round = {}, sdp::SdpSolver* fallback = nullptr);
+    const std::function<void(const GenerationRound&)>& on_round = {}, sdp::SdpSolver* fallback = nullptr);
 
 // A-priori bounds of the LMI variables of a moment relaxation, valid for every feasible point of its LMI.
 // When the problem contains a positive multiple of 1 - x_i^2 >= 0 for every variable (or the box [-1, 1]^n),
@@ -61,25 +91,5 @@ ConstraintGenerationResult SolveWithConstraintGeneration(
 // <= ... <= y_0 = 1, and 2x2 minors of the moment matrix bound the rest); an LMI variable that equals a moment
 // inherits [-1, 1]. Everything else is unbounded (+-infinity).
 sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const MomentRelaxation& relaxation);
-
-// LP screen of a semialgebraic set { g_i(x) >= 0 } inside [-1, 1]^n: each monomial of degree <= D becomes a
-// free variable with |y_alpha| <= 1 and y_alpha >= 0 for even alpha; infeasibility of this LP proves the set
-// empty (every point of the set maps to a feasible y). Returns the SDP summary (one diagonal block).
-// With `certificate`, an infeasible outcome is verified rigorously (|y| <= 1 is part of the LP); one that does
-// not verify becomes kNumericalTrouble (the set is then not declared empty).
-sdp::SdpSummary ScreenWithLinearProgram(const std::vector<Polynomial>& constraints, int num_vars,
-                                        const sdp::SdpOptions& options, sdp::SdpSolver& solver,
-                                        sdp::VerifiedBound* certificate = nullptr);
-
-// Rigorous bound of min (direction -1) or max (+1) of x_variable over { g_i(x) >= 0 } inside [-1, 1]^n from the
-// LP of ScreenWithLinearProgram: the bound is verified from the LP's multiplier (sdp/verified_bound.hpp), so it
-// holds whatever the solver's accuracy. Used to contract the prior box before the relaxations (set_membership).
-struct LinearProgramBoundResult {
-  enum Status { kBounded, kEmpty, kFailed } status = kFailed;  // kEmpty: verified certificate that the set is empty
-  double bound = 0.0;  // in [-1, 1], valid when kBounded
-  std::string summary_message;
-};
-LinearProgramBoundResult LinearProgramBound(const std::vector<Polynomial>& constraints, int num_vars, int variable,
-                                            int direction, const sdp::SdpOptions& options, sdp::SdpSolver& solver);
 
 }  // namespace hw::relax

@@ -108,12 +108,19 @@ long MomentIndex::product(long i, long j) const {
 }
 
 MomentRelaxation::MomentRelaxation(const PolyProblem& problem, int order)
+    : MomentRelaxation(problem, order, std::vector<int>(problem.inequalities.size(), -1)) {}
+
+MomentRelaxation::MomentRelaxation(const PolyProblem& problem, int order, const std::vector<int>& localizing_orders)
     : order_(order), sign_(problem.maximize ? -1.0 : 1.0), index_(problem.num_vars, 2 * order) {
   const int n = problem.num_vars;
   const MonomialBasis& full = index_.basis();
   const int m_full = static_cast<int>(full.size()) - 1;  // y_0 is the constant 1
 
+  if (localizing_orders.size() != problem.inequalities.size())
+    throw std::invalid_argument("MomentRelaxation: one localizing order per inequality expected");
   std::vector<Polynomial> inequalities = problem.inequalities;
+  std::vector<int> cap = localizing_orders;
+  cap.resize(inequalities.size() + problem.box.size(), -1);
   for (int i = 0; i < static_cast<int>(problem.box.size()); ++i) {
     const auto [lo, hi] = problem.box[i];
     const auto x = Polynomial::Variable(n, i);
@@ -139,9 +146,11 @@ MomentRelaxation::MomentRelaxation(const PolyProblem& problem, int order)
 
   // Localizing matrices; order-0 ones go to one diagonal block at the end.
   std::vector<const Polynomial*> scalar;
-  for (const auto& g : inequalities) {
-    const int k = order - ceil_half(std::max(0, g.degree()));
-    if (k < 0) throw std::invalid_argument(fmt::format("relaxation order {} is below the minimal order", order));
+  for (std::size_t i = 0; i < inequalities.size(); ++i) {
+    const Polynomial& g = inequalities[i];
+    const int full_k = order - ceil_half(std::max(0, g.degree()));
+    if (full_k < 0) throw std::invalid_argument(fmt::format("relaxation order {} is below the minimal order", order));
+    const int k = cap[i] < 0 ? full_k : std::min(cap[i], full_k);
     if (k == 0) {
       scalar.push_back(&g);
       continue;
@@ -273,8 +282,12 @@ Eigen::MatrixXd MomentRelaxation::moment_matrix(const std::vector<double>& y, in
   return M;
 }
 
+int MomentRelaxation::full_localizing_order(const Polynomial& g) const {
+  return order_ - ceil_half(std::max(0, g.degree()));
+}
+
 Eigen::MatrixXd MomentRelaxation::localizing_matrix(const Polynomial& g, const std::vector<double>& y) const {
-  const int k = order_ - ceil_half(std::max(0, g.degree()));
+  const int k = full_localizing_order(g);
   if (k < 0) throw std::invalid_argument("localizing_matrix: constraint degree exceeds 2 * order");
   const int size = static_cast<int>(MonomialBasis::count(index_.basis().num_vars(), k));
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(size, size);

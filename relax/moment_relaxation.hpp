@@ -63,6 +63,10 @@ struct RelaxationOptions {
 class MomentRelaxation {
  public:
   MomentRelaxation(const PolyProblem& problem, int order);
+  // Mixed orders (as in the bounded-degree hierarchy): inequality i gets the localizing matrix of order
+  // min(localizing_orders[i], order - ceil(deg g_i / 2)); -1 = full order, 0 = the scalar L_y(g_i) >= 0. Any
+  // choice relaxes the full order-delta relaxation, so its bound stays valid (and is never tighter).
+  MomentRelaxation(const PolyProblem& problem, int order, const std::vector<int>& localizing_orders);
 
   int order() const { return order_; }
   const sdp::LmiProblem& lmi() const { return lmi_; }
@@ -75,6 +79,8 @@ class MomentRelaxation {
   // Localizing matrix M_{order - ceil(deg g / 2)}(g y) at a full moment vector (for checking constraints
   // that were left out of the LMI).
   Eigen::MatrixXd localizing_matrix(const Polynomial& g, const std::vector<double>& moments) const;
+  // The full localizing order of g in this relaxation: order - ceil(deg g / 2).
+  int full_localizing_order(const Polynomial& g) const;
 
  private:
   int order_;

@@ -1,21 +1,21 @@
 #pragma once
 // Guaranteed parameter intervals of a Hammerstein–Wiener model over D^ss(n) (paper 001, eqs. 22-33).
 //
-// Pipeline, per run:
-//  1. LP screen of every sign orthant (ScreenWithLinearProgram): an infeasible LP proves the orthant empty.
-//  2. Cheap pass at the minimal order delta0 = ceil((n+1)/2) for every objective (min/max of every
-//     parameter) of every surviving orthant, by constraint generation. An infeasible relaxation proves
-//     the orthant empty. With box contraction on, the first cheap passes (few constraint-generation rounds
-//     each) contract each orthant's box to its bounds, and the last cheap pass runs in the contracted box
-//     (BoundsOptions::contraction_passes).
-//  3. Full pass at order delta: for each objective, orthants are solved in order of their cheap bound,
-//     most extreme first, and an orthant is skipped when its cheap bound cannot move the aggregated
-//     interval (its order-delta bound is at least as tight as its order-delta0 bound: Property 3).
-//     The result equals solving every orthant at order delta.
-// Guarantees: every reported endpoint is a valid bound (dual side of the SDP) of a relaxation of
-// D^ss(n) intersected with the prior box. A failed solve never disappears: the endpoint falls back to
-// the same orthant's cheap-order bound, or to the box edge, and is marked "conservative".
+// The engine is a pipeline of stages, each in its own file (docs: README, "How the bounds are computed"):
+//  1. screen orthants   (relax/orthant_screen.hpp): an LP per sign orthant; infeasible (verified) => empty.
+//  2. reduce rows       (relax/row_reduction.hpp):  drop data rows implied by the others (exact at any order).
+//  3. cheap pass        (relax/cheap_pass.hpp):     every objective of every live orthant at the minimal order.
+//  4. full pass         (relax/full_pass.hpp):      the wanted objectives at order delta, skipping orthants
+//                                                   whose cheap bound cannot move the interval (Property 3).
+//  5. aggregate         (relax/aggregate.hpp):      min/max over orthants, fallbacks, the prior box.
+// Every job (relax/bound_jobs.hpp) solves its relaxation by constraint generation over the kept rows
+// (relax/constraint_generation.hpp): rows enter as scalar moment constraints and get their localizing block
+// when violated; every round's multiplier yields a verified bound, so a solve that stops short still bounds.
+// Guarantees: every reported endpoint is a valid bound of D^ss(n) intersected with the prior box. A failed
+// solve never disappears: the endpoint falls back to the same orthant's cheap-order bound, or to the box edge,
+// and is marked "conservative"; an orthant is discarded only on a verified certificate.
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "relax/constraint_generation.hpp"
+#include "relax/row_reduction_options.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "sdp/job_executor.hpp"
 
@@ -32,8 +33,8 @@ struct BoundsOptions {
   int order = 3;                 // delta of the reported intervals
   bool cheap_pass = true;        // solve the minimal order first to skip objectives (recommended)
   bool lp_screen = true;
-  std::string solver = "sdpa";
-  bool retry_with_other_solver = true;  // a failed solve is repeated with the other backend before falling back
+  std::string solver = "sdpa";   // "csdp", "sdpa" or "dsdp"
+  bool retry_with_other_solver = true;  // a failed solve is repeated with the other backend (CSDP <-> SDPA; DSDP -> CSDP)
   // Local parallel jobs. CSDP and SDPA are not thread-safe, so jobs run in forked worker processes
   // (sdp::ForkExecutor); 0 = one per core. Ignored when `executor` is set.
   int threads = 0;
@@ -56,6 +57,10 @@ struct BoundsOptions {
   // The last cheap pass always runs to the full relaxation (generation.max_rounds).
   int contraction_max_rounds = 4;
   ConstraintGenerationOptions generation;  // its order is set per pass
+  RowReductionOptions reduction;           // exact reduction of the data rows (stage 2)
+  // Progress lines from inside jobs (one per constraint-generation round: working set, status, bound so far).
+  // Called in the process that runs the job (a forked worker or an MPI rank); null = silent.
+  std::function<void(const std::string&)> round_log;
   bool IsValid(std::string* error) const;
 };
 
@@ -84,7 +89,7 @@ struct OrthantReport {
 };
 
 struct BoundsProgress {
-  std::string phase;
+  std::string phase;   // with done = total = -1: a one-off message (e.g. "resuming: ...")
   int done = 0, total = 0;
   double elapsed_seconds = 0.0, eta_seconds = 0.0;
 };
@@ -109,8 +114,16 @@ struct BoundsSummary {
   // Contracted box of every orthant left at the end (index, box), and the cheap passes run in contracted boxes.
   std::vector<std::pair<int, std::vector<std::pair<double, double>>>> orthant_boxes;
   int contraction_passes_run = 0;
+  // Exact row reduction per live orthant: {"orthant", "per_step": [{"step", "rows", "kept"}]}.
+  std::vector<nlohmann::json> row_reduction;
+  // Where the orthant bounds entering the endpoints came from (see relax/aggregate.hpp).
+  std::map<std::string, int> bound_sources;
+  bool clipped_to_box = false;
   nlohmann::json to_json() const;
   bool all_guaranteed() const;
+  // Every orthant proven empty (by verified certificates when verification is on): no parameter in the box
+  // explains the data within the noise bound, so the model class or the noise bound is wrong.
+  bool invalidated() const;
 };
 
 BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,

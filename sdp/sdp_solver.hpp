@@ -32,6 +32,8 @@ struct SdpOptions {
   // (small POPs that stopped at pdFEAS/dFEAS finish that way). Callers with their own fallback chain turn it
   // off: on large ill-conditioned LMIs the second attempt mostly fails too and doubles the cost.
   bool retry_with_default_parameters = true;
+  // A warm start where the backend takes one (empty = none): an initial y, e.g. the previous round's solution.
+  std::vector<double> initial_y;
   bool IsValid(std::string* error) const;
 };
 

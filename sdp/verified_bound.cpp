@@ -286,25 +286,33 @@ VerifiedBound VerifyInfeasibility(const LmiProblem& problem, const std::vector<E
   return v;
 }
 
-VerifiedBound VerifyOptimalSolve(const VerifyOptions& options, const SdpOptions& sdp_options, const LmiProblem& problem,
-                                 const VariableBounds& bounds, const SdpSummary& summary, SdpSolver& solver) {
-  const auto t0 = Clock::now();
-  const double fb = summary.lower_bound;
-  VerifiedBound best = VerifyLowerBound(problem, summary.X, bounds, fb);
-  auto acceptable = [&](const VerifiedBound& v) {
-    return v.verified() && v.correction <= options.acceptable_correction * std::max(1.0, std::abs(fb));
-  };
-  // Cheap first remedy for residual-dominated corrections: project X onto the equalities (no re-solve).
-  if (!acceptable(best) && summary.X.size() == problem.blocks.size()) {
-    const auto P = ProjectOntoEqualities(problem, summary.X);
+VerifiedBound VerifyMultiplier(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X,
+                               const VariableBounds& bounds, double float_bound, double acceptable_correction) {
+  VerifiedBound best = VerifyLowerBound(problem, X, bounds, float_bound);
+  const bool acceptable =
+      best.verified() && best.correction <= acceptable_correction * std::max(1.0, std::abs(float_bound));
+  // Cheap remedy for residual-dominated corrections: project X onto the equalities (no re-solve).
+  if (!acceptable && X.size() == problem.blocks.size()) {
+    const auto P = ProjectOntoEqualities(problem, X);
     if (!P.empty()) {
-      VerifiedBound v = VerifyLowerBound(problem, P, bounds, fb);
+      VerifiedBound v = VerifyLowerBound(problem, P, bounds, float_bound);
       if (v.verified() && (!best.verified() || v.bound > best.bound)) {
         v.message += " [multiplier projected onto the equalities]";
         best = v;
       }
     }
   }
+  return best;
+}
+
+VerifiedBound VerifyOptimalSolve(const VerifyOptions& options, const SdpOptions& sdp_options, const LmiProblem& problem,
+                                 const VariableBounds& bounds, const SdpSummary& summary, SdpSolver& solver) {
+  const auto t0 = Clock::now();
+  const double fb = summary.lower_bound;
+  auto acceptable = [&](const VerifiedBound& v) {
+    return v.verified() && v.correction <= options.acceptable_correction * std::max(1.0, std::abs(fb));
+  };
+  VerifiedBound best = VerifyMultiplier(problem, summary.X, bounds, fb, options.acceptable_correction);
   // Re-solves only help when the multiplier is not safely PSD: unverified, or the eigenvalue term dominates.
   auto resolve_helps = [&](const VerifiedBound& v) {
     return !v.verified() || (!acceptable(v) && -v.eigenvalue_term > 0.5 * v.correction);

@@ -79,6 +79,12 @@ VerifiedBound VerifyLowerBound(const LmiProblem& problem, const std::vector<Eige
 VerifiedBound VerifyInfeasibility(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X,
                                   const VariableBounds& bounds);
 
+// Verifies ANY multiplier (an optimal solve's, or the last iterate of a solve that stopped short: weak duality
+// needs no convergence), and when the correction exceeds acceptable_correction (relative to max(1, |float|))
+// also X projected onto the equalities; keeps the better. No re-solve.
+VerifiedBound VerifyMultiplier(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X,
+                               const VariableBounds& bounds, double float_bound, double acceptable_correction);
+
 // Verifies an optimal solve; when the correction exceeds options.acceptable_correction, verifies X projected
 // onto the equalities F_i . X = c_i too; when still unverified (or the eigenvalue term dominates), solves
 // the perturbed problem min (c - eps tr F)^T y (whose multiplier X' gives X = X' + eps I >= eps I with the

@@ -15,6 +15,7 @@
 #include "core/cerone_example.hpp"
 #include "relax/basis.hpp"
 #include "relax/constraint_generation.hpp"
+#include "relax/moment_lp.hpp"
 #include "relax/set_membership.hpp"
 
 namespace hw::relax {
@@ -57,6 +58,7 @@ TEST(ConstraintGeneration, AFailedRoundFallsBackToTheLastSolvedRound) {
   ConstraintGenerationOptions o;
   o.order = 1;
   o.add_per_round = 1;
+  o.linear_rows_first = false;  // candidates enter only as blocks, so that a second round is needed
   // Reference: the full run needs a second round and reaches 0.5.
   auto csdp = sdp::MakeSolver("csdp");
   const auto full = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, *csdp);
@@ -72,11 +74,48 @@ TEST(ConstraintGeneration, AFailedRoundFallsBackToTheLastSolvedRound) {
   EXPECT_NEAR(r.bound, -1.0, 1e-5);
   EXPECT_LE(r.bound, full.bound + 1e-9);
   EXPECT_TRUE(r.verification.verified()) << r.verification.message;
-  EXPECT_NE(r.message.find("last solved round"), std::string::npos) << r.message;
+  EXPECT_EQ(r.origin, BoundOrigin::kEarlierRound);
+  EXPECT_EQ(r.bound_round, 1);
+  EXPECT_NE(r.message.find("the bound of round 1 is reported"), std::string::npos) << r.message;
   // A failure in the first round has nothing to fall back to: the job fails.
   FailsAfter always(0);
   const auto none = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, always);
   EXPECT_EQ(none.status, RelaxationStatus::kSolverFailed);
+}
+
+// Solves with CSDP capped at a few iterations: the solve stops short, but its last iterate X comes back.
+class StopsShort : public sdp::SdpSolver {
+ public:
+  std::string name() const override { return "stops-short"; }
+  sdp::SdpSummary Solve(const sdp::SdpOptions& options, const sdp::LmiProblem& problem) override {
+    sdp::SdpOptions capped = options;
+    capped.max_iterations = 4;
+    return inner_->Solve(capped, problem);
+  }
+
+ private:
+  std::unique_ptr<sdp::SdpSolver> inner_ = sdp::MakeSolver("csdp");
+};
+
+TEST(ConstraintGeneration, ASolveThatStopsShortStillGivesAVerifiedBound) {
+  ConstraintGenerationOptions o;
+  o.order = 2;
+  // min x1 over the disc x1^2 + x2^2 <= 0.5 in the box: -sqrt(0.5).
+  PolyProblem core = Core();
+  const auto x1 = Polynomial::Variable(2, 0), x2 = Polynomial::Variable(2, 1);
+  std::vector<Polynomial> candidates = {Polynomial::Constant(2, 0.5) - x1 * x1 - x2 * x2};
+  StopsShort short_solver;
+  const auto r = SolveWithConstraintGeneration(o, core, candidates, {}, short_solver);
+  ASSERT_NE(r.last_sdp.status, sdp::SdpStatus::kOptimal) << "the capped solve was expected to stop short";
+  ASSERT_EQ(r.status, RelaxationStatus::kSolved) << r.message;
+  EXPECT_TRUE(r.verification.verified()) << r.verification.message;
+  EXPECT_TRUE(r.bound_from_unfinished_solve);
+  EXPECT_FALSE(r.tight);
+  EXPECT_LE(r.bound, -std::sqrt(0.5) + 1e-9);  // a valid lower bound of the minimum
+  EXPECT_GE(r.bound, -1.0 - 1e-9);             // and no worse than the box
+  // Without verification, a solve that stopped short gives no bound at all.
+  o.verify.enabled = false;
+  EXPECT_EQ(SolveWithConstraintGeneration(o, core, candidates, {}, short_solver).status, RelaxationStatus::kSolverFailed);
 }
 
 TEST(LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {

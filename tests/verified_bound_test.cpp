@@ -10,6 +10,7 @@
 
 #include "core/cerone_example.hpp"
 #include "relax/constraint_generation.hpp"
+#include "relax/moment_lp.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/verified_bound.hpp"
 

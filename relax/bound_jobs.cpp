@@ -1,0 +1,331 @@
+#include "relax/bound_jobs.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <mutex>
+
+#include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+#include "relax/constraint_generation.hpp"
+#include "relax/moment_lp.hpp"
+#include "relax/row_reduction.hpp"
+
+namespace hw::relax {
+namespace fs = std::filesystem;
+namespace {
+
+uint64_t fnv(uint64_t h, const std::string& s) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string other_solver(const std::string& s) { return s == "csdp" ? "sdpa" : "csdp"; }
+
+}  // namespace
+
+nlohmann::json JobOutcome::to_json() const {
+  return {{"status", status}, {"bound", bound}, {"tight", tight}, {"message", message}, {"rounds", rounds},
+          {"sdp_iterations", sdp_iterations}, {"seconds", seconds}, {"moments", moments}, {"blocks", blocks},
+          {"working_set", working_set}, {"verification", verification}, {"float_bound", float_bound},
+          {"correction", correction}, {"verify_seconds", verify_seconds}, {"origin", origin},
+          {"bound_round", bound_round}, {"unfinished", unfinished}};
+}
+
+JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
+  JobOutcome o;
+  o.status = j.at("status");
+  o.bound = j.at("bound");
+  o.tight = j.at("tight");
+  o.message = j.at("message");
+  o.rounds = j.at("rounds");
+  o.sdp_iterations = j.at("sdp_iterations");
+  o.seconds = j.at("seconds");
+  o.moments = j.at("moments");
+  o.blocks = j.at("blocks");
+  o.working_set = j.at("working_set").get<std::vector<int>>();
+  o.verification = j.at("verification");
+  o.float_bound = j.at("float_bound");
+  o.correction = j.at("correction");
+  o.verify_seconds = j.at("verify_seconds");
+  o.origin = j.at("origin");
+  o.bound_round = j.at("bound_round");
+  o.unfinished = j.at("unfinished");
+  return o;
+}
+
+RunCache::RunCache(const std::string& root, const std::string& key, const nlohmann::json& meta) {
+  if (root.empty()) return;
+  const fs::path dir = fs::path(root) / key;
+  fs::create_directories(dir / "jobs");
+  if (!fs::exists(dir / "problem.json")) write_text_atomic((dir / "problem.json").string(), meta.dump(2));
+  dir_ = dir.string();
+}
+
+std::optional<nlohmann::json> RunCache::load(const std::string& name) const {
+  if (!enabled()) return std::nullopt;
+  std::ifstream in(fs::path(dir_) / "jobs" / (name + ".json"));
+  if (!in) return std::nullopt;
+  try {
+    nlohmann::json j;
+    in >> j;
+    return j;
+  } catch (...) {
+    return std::nullopt;
+  }
+}
+
+void RunCache::store(const std::string& name, const nlohmann::json& j) const {
+  if (enabled()) write_text_atomic((fs::path(dir_) / "jobs" / (name + ".json")).string(), j.dump());
+}
+
+int RunCache::stored_jobs() const {
+  if (!enabled()) return 0;
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(dir_) / "jobs"))
+    if (e.path().extension() == ".json") ++n;
+  return n;
+}
+
+ProgressReporter::ProgressReporter(std::function<void(const BoundsProgress&)> sink) : sink_(std::move(sink)) {}
+
+void ProgressReporter::Phase(const std::string& name, int total) {
+  phase_ = name;
+  done_ = 0;
+  total_ = total;
+  phase_start_ = now_seconds();
+  if (sink_ && total > 0) sink_({phase_, 0, total_, 0.0, 0.0});
+}
+
+void ProgressReporter::Done(int jobs) {
+  done_ += jobs;
+  if (!sink_) return;
+  const double el = now_seconds() - phase_start_;
+  sink_({phase_, done_, total_, el, done_ > 0 ? el / done_ * (total_ - done_) : 0.0});
+}
+
+void ProgressReporter::Message(const std::string& text) {
+  if (sink_) sink_({text, -1, -1, 0.0, 0.0});
+}
+
+std::string BoxHash(const Box& box) {
+  return fmt::format("{:016x}", fnv(1469598103934665603ull, nlohmann::json(box).dump()));
+}
+
+sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet& prior_set) {
+  // Per-process memo of the outer set in each box and of each orthant's data rows (built once, read-only after).
+  struct Memo {
+    std::mutex mutex;
+    std::map<std::string, std::unique_ptr<HwOuterSet>> sets;
+    std::map<std::pair<std::string, int>, std::vector<DataConstraint>> rows;
+  };
+  auto memo = std::make_shared<Memo>();
+  auto set_for = [memo, &prior_set](const Box& b) -> const HwOuterSet& {
+    if (b == prior_set.box()) return prior_set;
+    std::lock_guard<std::mutex> lock(memo->mutex);
+    auto& slot = memo->sets[BoxHash(b)];
+    if (!slot) slot = std::make_unique<HwOuterSet>(prior_set.WithBox(b));
+    return *slot;
+  };
+  auto rows_for = [memo, set_for](const Box& b, int l) -> const std::vector<DataConstraint>& {
+    const HwOuterSet& s = set_for(b);
+    std::lock_guard<std::mutex> lock(memo->mutex);
+    auto& r = memo->rows[{BoxHash(b), l}];
+    if (r.empty()) r = s.data_constraints(l);
+    return r;
+  };
+
+  return [&options, &prior_set, set_for, rows_for](const std::string& text) -> std::string {
+    const auto spec = nlohmann::json::parse(text);
+    const int l = spec.at("l");
+    const std::string kind = spec.at("kind");
+    const int n = prior_set.num_vars();
+    const auto& gen_options = options.generation;
+    if (kind == "lp") {
+      std::vector<Polynomial> cons = prior_set.sign_constraints(l);
+      for (const auto& d : rows_for(prior_set.box(), l)) cons.push_back(d.g);
+      auto solver = sdp::MakeSolver(options.solver == "dsdp" ? "csdp" : options.solver);
+      sdp::SdpOptions lp_options = gen_options.sdp;
+      lp_options.keep_dual_matrix = false;
+      sdp::VerifiedBound cert;
+      const auto s = ScreenWithLinearProgram(cons, n, lp_options, *solver, gen_options.verify.enabled ? &cert : nullptr);
+      return nlohmann::json{{"empty", s.status == sdp::SdpStatus::kInfeasible}, {"status", sdp::ToString(s.status)},
+                            {"verification", sdp::ToString(cert.status)}}
+          .dump();
+    }
+    const Box box = spec.at("box").get<Box>();
+    const HwOuterSet& set = set_for(box);
+    const auto& all_rows = rows_for(box, l);
+    if (kind == "reduce") {
+      std::vector<Polynomial> rows;
+      std::vector<int> steps;
+      for (const auto& d : all_rows) {
+        rows.push_back(d.g);
+        steps.push_back(d.s);
+      }
+      std::vector<Polynomial> fixed = set.box_constraints();
+      for (auto& g : set.sign_constraints(l)) fixed.push_back(std::move(g));
+      const auto r = ReduceDataRows(options.reduction, rows, steps, fixed);
+      nlohmann::json counts = nlohmann::json::array();
+      for (const auto& c : r.per_step) counts.push_back({{"step", c.step}, {"rows", c.rows}, {"kept", c.kept}});
+      return nlohmann::json{{"kept", r.kept}, {"per_step", counts}, {"linear_programs", r.linear_programs},
+                            {"seconds", r.seconds}}
+          .dump();
+    }
+    // kind == "relax"
+    const Objective obj{spec.at("param").get<int>(), spec.at("dir").get<int>()};
+    PolyProblem core;
+    core.num_vars = n;
+    core.objective = Polynomial::Variable(n, obj.param);
+    core.maximize = obj.dir > 0;
+    core.inequalities = set.box_constraints();
+    for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(std::move(g));
+    std::vector<Polynomial> candidates;
+    for (int i : spec.at("rows").get<std::vector<int>>()) candidates.push_back(all_rows.at(i).g);
+    ConstraintGenerationOptions gen = gen_options;
+    gen.order = spec.at("d");
+    if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
+    auto solver = sdp::MakeSolver(options.solver);
+    auto other = sdp::MakeSolver(other_solver(options.solver));
+    const std::string label = fmt::format("orthant {} {} {} order {}", l, obj.dir < 0 ? "min" : "max",
+                                          set.layout().names[obj.param], gen.order);
+    auto on_round = [&](const GenerationRound& r) {
+      if (!options.round_log) return;
+      const std::string bound =
+          std::isnan(r.bound) ? "none yet"
+                              : fmt::format("{} {:.6g}{}", obj.dir < 0 ? ">=" : "<=",
+                                            set.scaling().to_original(obj.param, r.bound),
+                                            r.bound_verified ? " (verified)" : "");
+      options.round_log(fmt::format("[{}] round {}: {} blocks + {} linear rows, {} ({:.1f} s), {} violated, bound {}",
+                                    label, r.round, r.blocks, r.linear_rows, r.status, r.seconds,
+                                    r.violated < 0 ? std::string("-") : std::to_string(r.violated), bound));
+    };
+    const auto r = SolveWithConstraintGeneration(gen, core, candidates, spec.at("initial").get<std::vector<int>>(),
+                                                 *solver, on_round, options.retry_with_other_solver ? other.get() : nullptr);
+    JobOutcome out;
+    out.rounds = r.rounds;
+    out.sdp_iterations = r.sdp_iterations;
+    out.seconds = r.solve_seconds;
+    out.moments = r.num_moments;
+    out.blocks = r.num_blocks;
+    out.working_set = r.working_set;
+    out.message = r.message;
+    out.tight = r.tight;
+    out.verification = sdp::ToString(r.verification.status);
+    out.verify_seconds = r.verification.seconds;
+    out.origin = ToString(r.origin);
+    out.bound_round = r.bound_round;
+    out.unfinished = r.bound_from_unfinished_solve;
+    if (r.status == RelaxationStatus::kInfeasible) {
+      out.status = "infeasible";
+    } else if (r.status == RelaxationStatus::kSolved) {
+      out.status = "solved";
+      out.float_bound = set.scaling().to_original(obj.param, r.float_bound);
+      out.bound = set.scaling().to_original(obj.param, r.bound);
+      if (r.verification.verified()) {
+        // The affine map back to original units rounds twice: widen outward by a few ulps of its terms.
+        const auto [lo, hi] = set.box()[obj.param];
+        out.bound += obj.dir * 4 * std::numeric_limits<double>::epsilon() * (std::max(std::abs(lo), std::abs(hi)) + (hi - lo));
+        out.correction = std::abs(out.bound - out.float_bound);
+      }
+    } else {
+      out.status = "failed";
+    }
+    return out.to_json().dump();
+  };
+}
+
+void DispatchJobs(EngineContext& ctx, const std::vector<std::pair<std::string, std::string>>& jobs,
+                  const std::function<void(std::size_t, const nlohmann::json&, bool)>& on_done) {
+  std::vector<std::string> specs;
+  std::vector<std::size_t> spec_job;
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    if (auto j = ctx.cache.load(jobs[i].second)) {
+      ++ctx.counters.jobs_from_cache;
+      on_done(i, *j, true);
+      continue;
+    }
+    specs.push_back(jobs[i].first);
+    spec_job.push_back(i);
+  }
+  ctx.executor.Map(specs, ctx.job, [&](std::size_t s, const sdp::JobResult& r) {
+    const std::size_t i = spec_job[s];
+    if (!r.ok) {  // a crashed or throwing job: reported by the caller, never dropped, not cached
+      on_done(i, nlohmann::json{{"job_error", r.error}}, false);
+      return;
+    }
+    auto j = nlohmann::json::parse(r.text);
+    ctx.cache.store(jobs[i].second, j);
+    on_done(i, j, false);
+  });
+}
+
+std::vector<int> RowsOfWorkingSet(const OrthantWork& orthant, const std::vector<int>& working_set) {
+  std::vector<int> rows;
+  for (int i : working_set) rows.push_back(orthant.rows.at(i));
+  return rows;
+}
+
+std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<RelaxJob>& jobs,
+                                          std::vector<OrthantWork>& orthants) {
+  std::vector<JobOutcome> outs(jobs.size());
+  std::vector<std::pair<std::string, std::string>> specs;
+  std::vector<std::size_t> spec_job;
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const RelaxJob& job = jobs[i];
+    const OrthantWork& o = *job.orthant;
+    if (o.empty()) {  // proven empty by an earlier job of this stage
+      outs[i].status = "infeasible";
+      outs[i].message = "orthant already proven empty (" + o.status + ")";
+      ctx.progress.Done();
+      continue;
+    }
+    // Data rows enter the spec as orthant row indices; the initial blocks as positions among them.
+    nlohmann::json spec{{"kind", "relax"}, {"l", o.index}, {"param", job.objective.param}, {"dir", job.objective.dir},
+                        {"d", job.order}, {"box", o.box}, {"rows", o.rows}, {"initial", job.initial}};
+    std::string key = fmt::format("o{}_l{}_{}_{}", job.order, o.index, ctx.set.layout().names[job.objective.param],
+                                  job.objective.dir < 0 ? "min" : "max");
+    if (o.box != ctx.set.box()) key += "_b" + BoxHash(o.box);
+    if (job.max_rounds > 0) {
+      spec["max_rounds"] = job.max_rounds;
+      key += fmt::format("_r{}", job.max_rounds);
+    }
+    specs.push_back({spec.dump(), key});
+    spec_job.push_back(i);
+  }
+  DispatchJobs(ctx, specs, [&](std::size_t s, const nlohmann::json& answer, bool cached) {
+    const std::size_t i = spec_job[s];
+    JobOutcome& out = outs[i];
+    if (answer.contains("job_error")) {
+      out.status = "failed";
+      out.message = "job failed: " + answer.at("job_error").get<std::string>();
+    } else {
+      out = JobOutcome::from_json(answer);
+    }
+    if (!cached) {
+      ++ctx.counters.sdp_jobs;
+      ctx.counters.sdp_solves += out.rounds;
+      ctx.counters.solve_seconds += out.seconds;
+      ctx.counters.verify_seconds += out.verify_seconds;
+      if (out.rounds) ctx.counters.solve_times.push_back(out.seconds / out.rounds);
+    }
+    ctx.counters.largest_moments = std::max(ctx.counters.largest_moments, out.moments);
+    ctx.counters.largest_blocks = std::max(ctx.counters.largest_blocks, out.blocks);
+    if (out.status == "infeasible") {
+      OrthantWork& o = orthants.at(static_cast<std::size_t>(&*jobs[i].orthant - orthants.data()));
+      if (!o.empty()) o.status = fmt::format("empty (order {}{})", jobs[i].order, o.box != ctx.set.box() ? ", contracted box" : "");
+    }
+    ctx.progress.Done();
+  });
+  return outs;
+}
+
+}  // namespace hw::relax

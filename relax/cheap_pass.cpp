@@ -1,0 +1,130 @@
+#include "relax/cheap_pass.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "relax/row_reduction.hpp"
+
+namespace hw::relax {
+namespace {
+
+// One pass: seeds first, then the other objectives from the seeds' blocks. `seed_rows` (data-row indices per
+// orthant) are the blocks the seeds start from.
+PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& objectives, std::vector<OrthantWork>& orthants,
+                        int order, int max_rounds, const std::string& phase,
+                        const std::map<int, std::vector<int>>& seed_rows) {
+  PassOutcomes out;
+  int total = 0;
+  for (const auto& o : orthants)
+    if (!o.empty()) total += static_cast<int>(objectives.size());
+  ctx.progress.Phase(phase, total);
+  std::vector<RelaxJob> seeds;
+  for (const auto& o : orthants) {
+    if (o.empty()) continue;
+    const auto it = seed_rows.find(o.index);
+    seeds.push_back({&o, objectives[0], order, it == seed_rows.end() ? std::vector<int>{} : PositionsOfRows(o, it->second),
+                     max_rounds});
+  }
+  const auto seed_out = RunRelaxationJobs(ctx, seeds, orthants);
+  std::vector<RelaxJob> rest;
+  std::vector<int> rest_objective;
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    out[{seeds[k].orthant->index, 0}] = seed_out[k];
+    for (int j = 1; j < static_cast<int>(objectives.size()); ++j) {
+      rest.push_back({seeds[k].orthant, objectives[j], order, seed_out[k].working_set, max_rounds});
+      rest_objective.push_back(j);
+    }
+  }
+  const auto rest_out = RunRelaxationJobs(ctx, rest, orthants);
+  for (std::size_t k = 0; k < rest.size(); ++k) out[{rest[k].orthant->index, rest_objective[k]}] = rest_out[k];
+  return out;
+}
+
+// Contracts each orthant's box to its verified cheap bounds; returns the largest relative shrink. Bounds that
+// cross prove the orthant empty.
+double ContractBoxes(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& pass,
+                     std::vector<OrthantWork>& orthants, int order) {
+  const bool verify_on = ctx.options.generation.verify.enabled;
+  const int n = ctx.set.num_vars();
+  double shrink = 0.0;
+  for (auto& o : orthants) {
+    if (o.empty()) continue;
+    Box next = o.box;
+    bool crossed = false;
+    for (int k = 0; k < n && !crossed; ++k) {
+      const double width = next[k].second - next[k].first;
+      for (std::size_t j = 0; j < objectives.size(); ++j) {
+        if (objectives[j].param != k) continue;
+        const auto& r = pass.at({o.index, static_cast<int>(j)});
+        if (r.status != "solved" || (verify_on && r.verification != "verified")) continue;
+        if (objectives[j].dir < 0) next[k].first = std::max(next[k].first, r.bound);
+        else next[k].second = std::min(next[k].second, r.bound);
+      }
+      if (next[k].first > next[k].second) {
+        crossed = true;  // rigorous bounds that cross: no point of the orthant in the box
+        break;
+      }
+      // A box side of (near) zero width would break the scaling: keep a sliver (widening stays valid).
+      const auto prior = ctx.set.box()[k];
+      const double min_width = 1e-6 * (prior.second - prior.first);
+      if (next[k].second - next[k].first < min_width) {
+        const double mid = 0.5 * (next[k].first + next[k].second);
+        next[k] = {std::max(prior.first, mid - min_width), std::min(prior.second, mid + min_width)};
+      }
+      shrink = std::max(shrink, 1.0 - (next[k].second - next[k].first) / width);
+    }
+    if (crossed) {
+      o.status = fmt::format("empty (order {}, contracted box)", order);
+      continue;
+    }
+    o.box = next;
+  }
+  return shrink;
+}
+
+}  // namespace
+
+std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<int>& data_rows) {
+  std::vector<int> pos;
+  for (int r : data_rows) {
+    const auto it = std::lower_bound(orthant.rows.begin(), orthant.rows.end(), r);
+    if (it != orthant.rows.end() && *it == r) pos.push_back(static_cast<int>(it - orthant.rows.begin()));
+  }
+  return pos;
+}
+
+CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
+                             const std::vector<Objective>& objectives, std::vector<OrthantWork>& orthants) {
+  CheapPassResult result;
+  std::map<int, std::vector<int>> seed_rows;  // data rows active in the previous pass, per orthant
+  for (int pass = 0;; ++pass) {
+    const bool contracting = pass < options.contraction_passes;
+    const std::string phase = contracting ? fmt::format("order {} box contraction {}", options.order, pass + 1)
+                                          : fmt::format("order {} relaxations", options.order);
+    const int max_rounds = contracting ? std::min(options.contraction_max_rounds, ctx.options.generation.max_rounds) : 0;
+    result.outcomes = RunOnePass(ctx, objectives, orthants, options.order, max_rounds, phase, seed_rows);
+    if (!contracting) break;
+    for (const auto& [key, r] : result.outcomes) {
+      const OrthantWork* o = nullptr;
+      for (const auto& w : orthants)
+        if (w.index == key.first) o = &w;
+      auto rows = RowsOfWorkingSet(*o, r.working_set);
+      auto& seed = seed_rows[key.first];
+      seed.insert(seed.end(), rows.begin(), rows.end());
+    }
+    for (auto& [l, rows] : seed_rows) {
+      std::sort(rows.begin(), rows.end());
+      rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    }
+    const double shrink = ContractBoxes(ctx, objectives, result.outcomes, orthants, options.order);
+    result.contraction_passes_run = pass + 1;
+    ReduceOrthantRows(ctx, orthants);  // the rows in the new boxes
+    // Little movement: skip the remaining contraction passes and run the last (full) cheap pass.
+    if (shrink < options.contraction_min_shrink) pass = std::max(pass, options.contraction_passes - 1);
+  }
+  return result;
+}
+
+}  // namespace hw::relax

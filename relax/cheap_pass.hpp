@@ -1,0 +1,36 @@
+#pragma once
+// Stage 3 of the bound engine: every objective of every live orthant at the cheap (minimal) order, optionally
+// repeated in contracted boxes (box contraction, BoundsOptions::contraction_passes).
+//
+// Deterministic warm starts: per orthant, the first objective runs first from no blocks (the seed); the other
+// objectives start from the blocks the seed found active. Which rows a job starts from therefore never depends
+// on which job finished first, so neither do the numbers.
+#include <map>
+#include <vector>
+
+#include "relax/bound_jobs.hpp"
+
+namespace hw::relax {
+
+// (orthant index, objective index) -> outcome.
+using PassOutcomes = std::map<std::pair<int, int>, JobOutcome>;
+
+struct CheapPassOptions {
+  int order = 2;
+  int contraction_passes = 0;  // see BoundsOptions
+  double contraction_min_shrink = 0.05;
+  int contraction_max_rounds = 4;
+};
+
+struct CheapPassResult {
+  PassOutcomes outcomes;  // of the last (uncapped) pass
+  int contraction_passes_run = 0;
+};
+
+CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
+                             const std::vector<Objective>& objectives, std::vector<OrthantWork>& orthants);
+
+// Positions in orthant.rows of the given data rows (rows no longer kept are skipped).
+std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<int>& data_rows);
+
+}  // namespace hw::relax

@@ -1,0 +1,25 @@
+#pragma once
+// Stage 4 of the bound engine: the wanted objectives at the full order delta. Per objective, orthants are
+// solved in order of their cheap bound, most extreme first, in waves (one orthant per objective per wave); an
+// orthant whose cheap bound cannot move the aggregated endpoint is skipped: its order-delta bound is at least as
+// tight as its cheap one (Property 3). The intervals equal those of solving every orthant at order delta.
+// A job starts from the blocks of its own cheap job and of the orthant's full-order jobs of earlier waves (never
+// of the same wave), so the numbers do not depend on which job finished first.
+#include <vector>
+
+#include "relax/cheap_pass.hpp"
+
+namespace hw::relax {
+
+struct FullPassOptions {
+  int order = 3;
+  int cheap_order = 2;
+};
+
+// Outcomes at full order for the wanted objectives; orthants skipped keep their cheap outcome with status
+// "skipped" (its bound is valid and cannot move the interval).
+PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, const std::vector<Objective>& objectives,
+                         const std::vector<int>& wanted_objectives, const PassOutcomes& cheap,
+                         std::vector<OrthantWork>& orthants);
+
+}  // namespace hw::relax

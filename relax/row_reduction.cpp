@@ -1,0 +1,171 @@
+#include "relax/row_reduction.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include <glpk.h>
+#include <fmt/format.h>
+
+namespace hw::relax {
+namespace {
+
+int ceil_half(int d) { return (d + 1) / 2; }
+
+struct GlpDeleter {
+  void operator()(glp_prob* p) const { glp_delete_prob(p); }
+};
+
+// The LP of one group: columns = candidate generators (group rows, then fixed constraints, then the constant 1),
+// rows = monomials of their joint support; a row g_i is implied iff  A lambda = c_i,  lambda >= 0  is feasible
+// with g_i's own column (and the columns of rows already dropped) fixed at zero.
+class CombinationLp {
+ public:
+  CombinationLp(const std::vector<const Polynomial*>& generators) : generators_(generators) {
+    for (const Polynomial* g : generators)
+      for (const auto& [e, c] : g->terms()) monomial_.emplace(e, 0);
+    int r = 1;
+    for (auto& [e, idx] : monomial_) idx = r++;
+    lp_.reset(glp_create_prob());
+    glp_set_obj_dir(lp_.get(), GLP_MIN);
+    glp_add_rows(lp_.get(), static_cast<int>(monomial_.size()));
+    glp_add_cols(lp_.get(), static_cast<int>(generators.size()));
+    std::vector<int> ia{0}, ja{0};
+    std::vector<double> ar{0.0};
+    for (int j = 0; j < static_cast<int>(generators.size()); ++j) {
+      glp_set_col_bnds(lp_.get(), j + 1, GLP_LO, 0.0, 0.0);
+      for (const auto& [e, c] : generators[j]->terms()) {
+        ia.push_back(monomial_.at(e));
+        ja.push_back(j + 1);
+        ar.push_back(c);
+      }
+    }
+    for (int i = 1; i <= static_cast<int>(monomial_.size()); ++i) glp_set_row_bnds(lp_.get(), i, GLP_FX, 0.0, 0.0);
+    glp_load_matrix(lp_.get(), static_cast<int>(ia.size()) - 1, ia.data(), ja.data(), ar.data());
+    glp_std_basis(lp_.get());
+    glp_init_smcp(&parm_);
+    parm_.msg_lev = GLP_MSG_OFF;
+    parm_.meth = GLP_DUALP;
+    parm_.presolve = GLP_OFF;
+  }
+
+  // Is generator `j` a nonnegative combination of the other active generators? (one LP)
+  bool Implied(int j, double residual_tolerance) {
+    const Polynomial& g = *generators_[j];
+    glp_set_col_bnds(lp_.get(), j + 1, GLP_FX, 0.0, 0.0);
+    std::vector<double> rhs(monomial_.size() + 1, 0.0);
+    for (const auto& [e, c] : g.terms()) rhs[monomial_.at(e)] = c;
+    for (int i = 1; i <= static_cast<int>(monomial_.size()); ++i) glp_set_row_bnds(lp_.get(), i, GLP_FX, rhs[i], rhs[i]);
+    int rc = glp_simplex(lp_.get(), &parm_);
+    if (rc != 0) {  // the warm basis went bad (singular): start again from the standard basis
+      glp_std_basis(lp_.get());
+      rc = glp_simplex(lp_.get(), &parm_);
+    }
+    bool implied = rc == 0 && glp_get_prim_stat(lp_.get()) == GLP_FEAS && ResidualOk(rhs, residual_tolerance);
+    if (!implied) glp_set_col_bnds(lp_.get(), j + 1, GLP_LO, 0.0, 0.0);  // kept: it stays a generator
+    return implied;
+  }
+
+ private:
+  // Checks the combination in double precision against the row itself (the LP's own tolerances are relative).
+  bool ResidualOk(const std::vector<double>& rhs, double tol) const {
+    std::vector<double> r = rhs;
+    for (int j = 0; j < static_cast<int>(generators_.size()); ++j) {
+      const double lambda = glp_get_col_prim(lp_.get(), j + 1);
+      if (lambda < 0) return false;
+      if (lambda == 0) continue;
+      for (const auto& [e, c] : generators_[j]->terms()) r[monomial_.at(e)] -= lambda * c;
+    }
+    for (std::size_t i = 1; i < r.size(); ++i)
+      if (!(std::abs(r[i]) <= tol)) return false;
+    return true;
+  }
+
+  std::vector<const Polynomial*> generators_;
+  std::map<Exponents, int> monomial_;
+  std::unique_ptr<glp_prob, GlpDeleter> lp_;
+  glp_smcp parm_;
+};
+
+}  // namespace
+
+bool RowReductionOptions::IsValid(std::string* error) const {
+  if (!(residual_tolerance > 0 && residual_tolerance < 1e-3)) {
+    if (error) *error = "row reduction residual_tolerance must lie in (0, 1e-3)";
+    return false;
+  }
+  return true;
+}
+
+RowReductionResult ReduceDataRows(const RowReductionOptions& options, const std::vector<Polynomial>& rows,
+                                  const std::vector<int>& step, const std::vector<Polynomial>& fixed) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RowReductionResult out;
+  std::map<int, RowGroupCount> counts;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    counts[step[i]].step = step[i];
+    ++counts[step[i]].rows;
+  }
+  // Groups: rows of one step with one localizing order (ceil(deg / 2)); only they combine with each other.
+  std::map<std::pair<int, int>, std::vector<int>> groups;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    groups[{step[i], ceil_half(rows[i].degree())}].push_back(static_cast<int>(i));
+  std::vector<char> keep(rows.size(), 1);
+  if (options.enabled && !rows.empty()) {
+    const Polynomial one = Polynomial::Constant(rows.front().num_vars(), 1.0);
+    for (const auto& [key, members] : groups) {
+      std::vector<const Polynomial*> generators;
+      for (int i : members) generators.push_back(&rows[i]);
+      for (const auto& f : fixed)
+        if (ceil_half(f.degree()) <= key.second) generators.push_back(&f);
+      generators.push_back(&one);
+      CombinationLp lp(generators);
+      for (std::size_t k = 0; k < members.size(); ++k) {
+        ++out.linear_programs;
+        if (lp.Implied(static_cast<int>(k), options.residual_tolerance)) keep[members[k]] = 0;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (keep[i]) {
+      out.kept.push_back(static_cast<int>(i));
+      ++counts[step[i]].kept;
+    }
+  for (const auto& [s, c] : counts) out.per_step.push_back(c);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace hw::relax
+
+namespace hw::relax {
+
+void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants) {
+  std::vector<std::pair<std::string, std::string>> jobs;
+  std::vector<std::size_t> job_orthant;
+  for (std::size_t k = 0; k < orthants.size(); ++k) {
+    const OrthantWork& o = orthants[k];
+    if (o.empty()) continue;
+    std::string key = fmt::format("reduce_l{}", o.index);
+    if (o.box != ctx.set.box()) key += "_b" + BoxHash(o.box);
+    if (!ctx.options.reduction.enabled) key += "_off";
+    jobs.push_back({nlohmann::json{{"kind", "reduce"}, {"l", o.index}, {"box", o.box}}.dump(), key});
+    job_orthant.push_back(k);
+  }
+  ctx.progress.Phase("exact reduction of data rows", static_cast<int>(jobs.size()));
+  DispatchJobs(ctx, jobs, [&](std::size_t i, const nlohmann::json& answer, bool) {
+    OrthantWork& o = orthants[job_orthant[i]];
+    if (answer.contains("job_error")) {  // the reduction only saves work: a failed one keeps every row
+      o.reduction = {nlohmann::json{{"error", answer.at("job_error")}}};
+      ctx.progress.Done();
+      return;
+    }
+    o.rows = answer.at("kept").get<std::vector<int>>();
+    o.reduction = answer.at("per_step").get<std::vector<nlohmann::json>>();
+    ctx.progress.Done();
+  });
+}
+
+}  // namespace hw::relax

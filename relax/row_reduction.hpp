@@ -1,0 +1,51 @@
+#pragma once
+// Exact reduction of the data inequalities of one sign orthant (stage 1 of the bound engine).
+//
+// All data rows of one horizon step share a monomial support, so each row g_i is a coefficient vector and its
+// localizing matrix M_k(g_i y) is linear in it. If g_i = sum_j lambda_j g_j + lambda_0 * 1 + sum_f mu_f f with
+// lambda, mu >= 0, where the g_j are other kept rows and the f are the always-present constraints (box, signs)
+// whose localizing order is at least g_i's (ceil(deg / 2) no larger), then M_k(g_i y) is the same nonnegative
+// combination of principal submatrices of blocks already in the relaxation: dropping g_i changes no bound, at
+// any order, and none of the LP screen either. One LP per row decides it (GLPK, dual simplex from the previous
+// basis: only the right-hand side changes between rows). Rows are tested in index order against the rows
+// still kept, so every dropped row is implied by the final kept set (implication is transitive).
+//
+// Dropping a row only enlarges the relaxed set, so the reduction can never invalidate a bound; the LP's
+// accuracy matters for tightness alone, and a combination is accepted only when its residual is checked.
+#include <string>
+#include <vector>
+
+#include "core/polynomial.hpp"
+#include "relax/row_reduction_options.hpp"
+
+namespace hw::relax {
+
+struct RowGroupCount {
+  int step = 0;       // horizon step s of the rows
+  int rows = 0;       // rows before the reduction
+  int kept = 0;       // rows kept
+};
+
+struct RowReductionResult {
+  std::vector<int> kept;                // indices into `rows`, ascending
+  std::vector<RowGroupCount> per_step;  // ascending step
+  int linear_programs = 0;
+  double seconds = 0.0;
+};
+
+// rows[i] with step[i]: the data inequalities g_i >= 0 of one orthant; fixed: constraints present in every
+// relaxation (box and sign constraints), usable in combinations.
+RowReductionResult ReduceDataRows(const RowReductionOptions& options, const std::vector<Polynomial>& rows,
+                                  const std::vector<int>& step, const std::vector<Polynomial>& fixed);
+
+}  // namespace hw::relax
+
+#include "relax/bound_jobs.hpp"
+
+namespace hw::relax {
+
+// Stage 2 of the bound engine: reduces the data rows of every live orthant in its current box (one job per
+// orthant; the kept rows and the counts per step land in each OrthantWork).
+void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants);
+
+}  // namespace hw::relax
