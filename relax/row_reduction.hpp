@@ -6,8 +6,8 @@
 // lambda, mu >= 0, where the g_j are other kept rows and the f are the always-present constraints (box, signs)
 // whose localizing order is at least g_i's (ceil(deg / 2) no larger), then M_k(g_i y) is the same nonnegative
 // combination of principal submatrices of blocks already in the relaxation: dropping g_i changes no bound, at
-// any order, and none of the LP screen either. One LP per row decides it (GLPK, dual simplex from the previous
-// basis: only the right-hand side changes between rows). Rows are tested in index order against the rows
+// any order, and none of the LP screen either. One LP per row decides it (GLPK, primal simplex from the previous
+// basis: only the right-hand side and one column's bounds change between rows). Rows are tested in index order against the rows
 // still kept, so every dropped row is implied by the final kept set (implication is transitive).
 //
 // Dropping a row only enlarges the relaxed set, so the reduction can never invalidate a bound; the LP's
