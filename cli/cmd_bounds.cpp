@@ -157,6 +157,10 @@ void AddBoundsCommand(CLI::App& app) {
         fmt::print(stderr, "{}\n", p.phase);
         return;
       }
+      // A line per phase start and end, and at most one every 5 s in between.
+      static double last_line = -1e9;
+      if (p.done > 0 && p.done < p.total && p.elapsed_seconds - last_line < 5.0) return;
+      last_line = p.elapsed_seconds;
       fmt::print(stderr, "[{}] {}/{} jobs, elapsed {:.0f} s, ETA {:.0f} s\n", p.phase, p.done, p.total,
                  p.elapsed_seconds, p.eta_seconds);
     };

@@ -210,8 +210,14 @@ SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, co
   return out;
 }
 
+// OpenBLAS (the BLAS of both libraries here) starts one thread per core by default; jobs already run one per
+// core in worker processes, so each solve uses one BLAS thread: no oversubscription, and the same arithmetic
+// whatever the number of workers (results must not depend on it).
+extern "C" void openblas_set_num_threads(int);
+
 SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
                           const std::function<SdpSummary(const LmiProblem&)>& solve) {
+  openblas_set_num_threads(1);
   std::string error;
   if (!options.IsValid(&error) || !problem.IsValid(&error)) {
     SdpSummary out;
