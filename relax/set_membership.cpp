@@ -130,7 +130,7 @@ bool BoundsOptions::IsValid(std::string* error) const {
   if (contraction_passes < 0) return fail("contraction_passes must be >= 0");
   if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
   if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
-  if (solver != "csdp" && solver != "sdpa") return fail(fmt::format("solver '{}' unknown; expected csdp or sdpa", solver));
+  if (solver != "csdp" && solver != "sdpa" && solver != "dsdp") return fail(fmt::format("solver '{}' unknown; expected csdp, sdpa or dsdp", solver));
   ConstraintGenerationOptions g = generation;
   return g.IsValid(error);
 }
