@@ -71,6 +71,50 @@ DsdpLayout MakeLayout(const LmiProblem& problem) {
 // (the lower triangle row by row). Our entries are upper-triangular (row <= col), i.e. (col, row) there.
 int PackedIndex(int row, int col) { return col * (col + 1) / 2 + row; }
 
+// The slack F(y) = sum y_i F_i - F_0, block by block.
+std::vector<Eigen::MatrixXd> SlackAt(const LmiProblem& problem, const std::vector<double>& y) {
+  std::vector<Eigen::MatrixXd> Z;
+  for (const auto& b : problem.blocks) Z.push_back(Eigen::MatrixXd::Zero(b.size, b.size));
+  for (int i = 0; i <= problem.num_vars(); ++i) {
+    const double w = i == 0 ? -1.0 : y[i - 1];
+    for (const auto& e : problem.F[i]) {
+      Z[e.block](e.row, e.col) += w * e.value;
+      if (e.row != e.col) Z[e.block](e.col, e.row) += w * e.value;
+    }
+  }
+  return Z;
+}
+
+// Smallest and largest-magnitude eigenvalue over all blocks of a slack (diagonal blocks: their diagonal).
+struct SlackSpectrum {
+  double min = INFINITY;
+  double max_abs = 0.0;
+};
+
+SlackSpectrum SpectrumOf(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& Z) {
+  SlackSpectrum s;
+  for (std::size_t b = 0; b < Z.size(); ++b) {
+    const Eigen::VectorXd lambda =
+        problem.blocks[b].kind == BlockSpec::Kind::kDiagonal
+            ? Eigen::VectorXd(Z[b].diagonal())
+            : Eigen::VectorXd(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Z[b], Eigen::EigenvaluesOnly).eigenvalues());
+    s.min = std::min(s.min, lambda.minCoeff());
+    s.max_abs = std::max(s.max_abs, lambda.cwiseAbs().maxCoeff());
+  }
+  return s;
+}
+
+// DSDP starts from y0 = initial_y only as far as its infeasibility variable r lets it (its slack is
+// C - A^T y + r I). Left to itself it raises r0 by factors of 100 until that is positive definite and then scales
+// it up by the dimension, which washes the start out: the iterates equal a cold start's to 1e-12. With a warm
+// start r0 is set here: enough to make F(y0) + r0 I positive definite, plus a margin of 1 + max |lambda(F(y0))|
+// that keeps the start off the boundary (a start on the boundary, margin ~0, saved no iterations; with this
+// margin a start at the optimum does: tests/dsdp_backend_test.cpp, WarmStartIsUsed).
+double WarmStartShift(const LmiProblem& problem, const std::vector<double>& y0) {
+  const SlackSpectrum s = SpectrumOf(problem, SlackAt(problem, y0));
+  return std::max(0.0, -s.min) + 1.0 + s.max_abs;
+}
+
 // The data as DSDP takes it. DSDP keeps pointers into these arrays until DSDPDestroy(), so they outlive the solve.
 struct DsdpData {
   struct SparseMatrix {
@@ -164,7 +208,8 @@ DsdpCones LoadCones(DSDP dsdp, const DsdpLayout& layout, const DsdpData& d) {
   return cones;
 }
 
-void SetOptions(DSDP dsdp, const SdpOptions& options, const LmiProblem& problem) {
+// r0 < 0: DSDP chooses its initial infeasibility (no warm start).
+void SetOptions(DSDP dsdp, const SdpOptions& options, const LmiProblem& problem, double r0) {
   for (int i = 0; i < problem.num_vars(); ++i)
     Check(DSDPSetDualObjective(dsdp, i + 1, -problem.c[i]), "DSDPSetDualObjective");  // b = -c
   // DSDP stops when (pp - dd) / (1 + |pp|/2 + |dd|/2) <= gap tolerance and its infeasibility variable r (the
@@ -174,6 +219,7 @@ void SetOptions(DSDP dsdp, const SdpOptions& options, const LmiProblem& problem)
   Check(DSDPSetMaxIts(dsdp, options.max_iterations), "DSDPSetMaxIts");
   for (std::size_t i = 0; i < options.initial_y.size(); ++i)
     Check(DSDPSetY0(dsdp, static_cast<int>(i) + 1, options.initial_y[i]), "DSDPSetY0");
+  if (r0 >= 0) Check(DSDPSetR0(dsdp, r0), "DSDPSetR0");
   if (options.verbose) Check(DSDPSetStandardMonitor(dsdp, 1), "DSDPSetStandardMonitor");
 }
 
@@ -215,31 +261,30 @@ struct DsdpOutcome {
   double y_lower = 0, y_upper = 0;
   double errors[6] = {0, 0, 0, 0, 0, 0};
   double setup_call_seconds = 0;  // DSDPSetup (Schur structure, data norms, scaling)
-  double solve_call_seconds = 0;  // DSDPSolve and DSDPComputeX
+  int solve_code = 0;             // DSDPSolve's return code (nonzero: it failed, DSDP printed a traceback)
+  int x_code = 0;                 // DSDPComputeX's
 };
 
 DsdpOutcome RunDsdp(const SdpOptions& options, const LmiProblem& problem, const DsdpLayout& layout,
-                    const DsdpData& data) {
+                    const DsdpData& data, double r0) {
   DsdpOutcome o;
   const int m = problem.num_vars();
   DsdpHandle handle(m);
   DSDP dsdp = handle.get();
   const DsdpCones cones = LoadCones(dsdp, layout, data);
-  SetOptions(dsdp, options, problem);
+  SetOptions(dsdp, options, problem, r0);
   const auto t_setup = Clock::now();
   Check(DSDPSetup(dsdp), "DSDPSetup");
   o.setup_call_seconds = SecondsSince(t_setup);
-  const auto t_solve = Clock::now();
-  // A failed DSDPSolve leaves a partial iterate: read it like any solve that stopped short.
-  const int solve_info = DSDPSolve(dsdp);
+  // A failed DSDPSolve leaves a partial iterate: it is read like any solve that stopped short.
+  o.solve_code = DSDPSolve(dsdp);
   Check(DSDPStopReason(dsdp, &o.reason), "DSDPStopReason");
   if (o.reason != DSDP_INFEASIBLE_START) {  // DSDP's own driver skips X after an infeasible start, too
-    Check(DSDPComputeX(dsdp), "DSDPComputeX");  // may downgrade the reason (X not accurate enough)
-    o.x_computed = true;
+    o.x_code = DSDPComputeX(dsdp);          // may downgrade the reason (X not accurate enough)
+    o.x_computed = o.x_code == 0;
   }
-  o.solve_call_seconds = SecondsSince(t_solve);
   Check(DSDPStopReason(dsdp, &o.reason), "DSDPStopReason");
-  if (solve_info != 0 && o.reason == DSDP_CONVERGED) o.reason = DSDP_NUMERICAL_ERROR;
+  if ((o.solve_code != 0 || o.x_code != 0) && o.reason == DSDP_CONVERGED) o.reason = DSDP_NUMERICAL_ERROR;
   Check(DSDPGetSolutionType(dsdp, &o.type), "DSDPGetSolutionType");
   o.y.assign(m, 0.0);
   Check(DSDPGetY(dsdp, o.y.data(), m), "DSDPGetY");
@@ -294,18 +339,11 @@ std::vector<Eigen::MatrixXd> MultiplierBlocks(const LmiProblem& problem, const D
   return X;
 }
 
-// The slack F(y) = sum y_i F_i - F_0, block by block.
-std::vector<Eigen::MatrixXd> SlackAt(const LmiProblem& problem, const std::vector<double>& y) {
-  std::vector<Eigen::MatrixXd> Z;
-  for (const auto& b : problem.blocks) Z.push_back(Eigen::MatrixXd::Zero(b.size, b.size));
-  for (int i = 0; i <= problem.num_vars(); ++i) {
-    const double w = i == 0 ? -1.0 : y[i - 1];
-    for (const auto& e : problem.F[i]) {
-      Z[e.block](e.row, e.col) += w * e.value;
-      if (e.row != e.col) Z[e.block](e.col, e.row) += w * e.value;
-    }
-  }
-  return Z;
+// ||F||_F of one (upper-triangular) matrix of the problem.
+double FrobeniusNorm(const std::vector<Entry>& F) {
+  double s = 0.0;
+  for (const auto& e : F) s += e.value * e.value * (e.row == e.col ? 1.0 : 2.0);
+  return std::sqrt(s);
 }
 
 // ||(F_i . X - c_i)_i||_2 / (1 + ||c||_2), as CSDP measures it.
@@ -336,6 +374,8 @@ nlohmann::json Details(const DsdpOutcome& o, double wait_seconds) {
           {"y_bounds", {o.y_lower, o.y_upper}},
           {"final_errors", std::vector<double>(o.errors, o.errors + 6)},
           {"iterations", o.iterations},
+          {"solve_code", o.solve_code},
+          {"compute_x_code", o.x_code},
           {"dsdp_setup_seconds", o.setup_call_seconds},
           {"lock_wait_seconds", wait_seconds}};
 }
@@ -386,6 +426,7 @@ SdpSummary SolveWithDsdp(const SdpOptions& options, const LmiProblem& problem) {
   const auto t0 = Clock::now();
   const DsdpLayout layout = MakeLayout(problem);
   const DsdpData data = BuildData(problem, layout);
+  const double r0 = options.initial_y.empty() ? -1.0 : WarmStartShift(problem, options.initial_y);
   out.setup_seconds = SecondsSince(t0);
   DsdpOutcome o;
   double wait_seconds = 0.0;
@@ -394,7 +435,7 @@ SdpSummary SolveWithDsdp(const SdpOptions& options, const LmiProblem& problem) {
     std::lock_guard<std::mutex> lock(DsdpMutex());
     wait_seconds = SecondsSince(t_wait);
     const auto t1 = Clock::now();
-    o = RunDsdp(options, problem, layout, data);
+    o = RunDsdp(options, problem, layout, data, r0);
     out.solve_seconds = SecondsSince(t1);
   } catch (const DsdpCallFailed& e) {
     out.status = SdpStatus::kNumericalTrouble;
@@ -413,8 +454,11 @@ SdpSummary SolveWithDsdp(const SdpOptions& options, const LmiProblem& problem) {
   out.lower_bound = f0x + problem.objective_offset;
   out.relative_gap = RelativeGap(cy, f0x);
   out.primal_infeasibility = PrimalInfeasibility(problem, out.X);
-  out.dual_infeasibility = o.errors[2];  // |r| / (1 + ||C||): F(y) + r I >= 0 holds by DSDP's construction
+  // Of the LMI at the returned y: max(0, -lambda_min(F(y))) / (1 + ||F_0||_F). (DSDP's own measure, its r, belongs
+  // to its last iterate, which may be newer than the y it returns.)
+  out.dual_infeasibility = std::max(0.0, -SpectrumOf(problem, out.Z).min) / (1.0 + FrobeniusNorm(problem.F[0]));
   out.details = Details(o, wait_seconds);
+  if (r0 >= 0) out.details["warm_start_r0"] = r0;
   const double dsdp_gap = DsdpRelativeGap(cy, f0x);
   out.details["dsdp_relative_gap"] = dsdp_gap;
   out.message = fmt::format("DSDP {} ({}) after {} iterations: F0.X {:.9g}, c'y {:.9g}", ReasonName(o.reason),
