@@ -8,6 +8,7 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "relax/set_membership.hpp"
+#include "sdp/sdp_solver.hpp"
 
 namespace hw::cli {
 namespace {
@@ -83,7 +84,7 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--horizon", o->horizon, "dynamic horizon n");
   cmd->add_option("--order", o->order, "relaxation order delta (default: minimal order ceil((n+1)/2))");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI (default -10,10)");
-  cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember({"csdp", "sdpa"}));
+  cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
   cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; default: all cores)");
   cmd->add_option("--executor", o->executor,
                   "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "

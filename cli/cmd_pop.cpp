@@ -4,6 +4,7 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "relax/pop_json.hpp"
+#include "sdp/sdp_solver.hpp"
 #include "sdp/sdpa_format.hpp"
 
 namespace hw::cli {
@@ -18,7 +19,7 @@ void AddPopCommand(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("PROBLEM", o->problem, "problem JSON (see README: Polynomial problems)")->required();
   cmd->add_option("--order", o->order, "relaxation order delta (default: minimal)");
-  cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember({"csdp", "sdpa"}));
+  cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
   cmd->add_option("--export", o->export_path, "also write the SDP in SDPA sparse format (.dat-s)");
   cmd->add_flag("--json", o->json, "machine-readable output");
   cmd->callback([o] {

@@ -102,7 +102,7 @@ bool Scenario::IsValid(std::string* error) const {
   if (sm.order < (sm.horizon + 2) / 2)
     return fail(fmt::format("setmembership: order {} is below the minimal order ceil((n+1)/2) = {} for horizon {}",
                             sm.order, (sm.horizon + 2) / 2, sm.horizon));
-  if (sm.solver != "sdpa" && sm.solver != "csdp") return fail("setmembership.solver: sdpa or csdp");
+  if (sm.solver != "sdpa" && sm.solver != "csdp" && sm.solver != "dsdp") return fail("setmembership.solver: sdpa, csdp or dsdp");
   const auto& es = esmaeilani;
   if (es.segments < 1 || es.samples < 20 || es.hold_min < 1 || es.hold_max < es.hold_min || es.grid_f < 2 ||
       es.grid_g < 2 || es.max_iterations < 1)

@@ -2,7 +2,7 @@
 # Installs the Debian packages hwbounds needs and builds it (Release) into build/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PACKAGES=(cmake g++ make libeigen3-dev libsdp-dev coinor-csdp libsdpa-dev sdpa libsuitesparse-dev libcli11-dev
+PACKAGES=(cmake g++ make libeigen3-dev libsdp-dev coinor-csdp libsdpa-dev sdpa libdsdp-dev libsuitesparse-dev libcli11-dev
           nlohmann-json3-dev libfmt-dev gnuplot-nox libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
           coinor-libipopt-dev libglpk-dev libcgal-dev libgmp-dev libmpfr-dev libtbb-dev pkg-config)
 missing=()

@@ -282,7 +282,8 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
 }  // namespace
 
 SdpSummary CsdpSolver::Solve(const SdpOptions& options, const LmiProblem& problem) {
-  return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) { return SolveWithCsdp(options, p); });
+  return SolveAsBackend(name(), options, problem,
+                        [](const SdpOptions& o, const LmiProblem& p) { return SolveWithCsdp(o, p); });
 }
 
 }  // namespace hw::sdp

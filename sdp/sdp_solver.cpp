@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "sdp/csdp_backend.hpp"
+#include "sdp/dsdp_backend.hpp"
 #include "sdp/sdpa_backend.hpp"
 
 extern "C" void openblas_set_num_threads(int);
@@ -25,6 +26,8 @@ bool SdpOptions::IsValid(std::string* error) const {
   if (!(feasibility_tolerance > 0 && feasibility_tolerance < 1)) return fail("feasibility_tolerance must lie in (0, 1)");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(acceptable_gap >= gap_tolerance && acceptable_gap < 1)) return fail("acceptable_gap must lie in [gap_tolerance, 1)");
+  for (std::size_t i = 0; i < initial_y.size(); ++i)
+    if (!std::isfinite(initial_y[i])) return fail(fmt::format("initial_y[{}] is not finite", i));
   return true;
 }
 
@@ -39,6 +42,12 @@ std::string ToString(SdpStatus s) {
     case SdpStatus::kInvalidProblem: return "invalid_problem";
   }
   return "unknown";
+}
+
+double InnerProduct(const std::vector<Entry>& F, const std::vector<Eigen::MatrixXd>& X) {
+  double s = 0.0;
+  for (const auto& e : F) s += e.value * X[e.block](e.row, e.col) * (e.row == e.col ? 1.0 : 2.0);
+  return s;
 }
 
 double InfeasibilityResidual(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X) {
@@ -56,15 +65,10 @@ double InfeasibilityResidual(const LmiProblem& problem, const std::vector<Eigen:
                             : Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(B, Eigen::EigenvaluesOnly).eigenvalues()(0);
     if (lmin < -1e-10 * std::max(scale, 1e-300)) return inf;
   }
-  auto inner = [&](const std::vector<Entry>& F) {
-    double s = 0.0;
-    for (const auto& e : F) s += e.value * X[e.block](e.row, e.col) * (e.row == e.col ? 1.0 : 2.0);
-    return s;
-  };
-  const double f0 = inner(problem.F[0]);
+  const double f0 = InnerProduct(problem.F[0], X);
   if (!(f0 > 0)) return inf;
   double sum = 0.0;
-  for (std::size_t i = 1; i < problem.F.size(); ++i) sum += std::abs(inner(problem.F[i]));
+  for (std::size_t i = 1; i < problem.F.size(); ++i) sum += std::abs(InnerProduct(problem.F[i], X));
   return sum / f0;
 }
 
@@ -200,7 +204,7 @@ SdpSummary DecideConstantLmi(const LmiProblem& p) {
 }  // namespace
 
 SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, const LmiProblem& problem,
-                          const std::function<SdpSummary(const LmiProblem&)>& solve) {
+                          const CanonicalSolve& solve) {
   SdpSummary out = SolveCanonical(options, problem, solve);
   out.solver = name;
   if (!options.keep_dual_matrix) {
@@ -215,11 +219,13 @@ SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, co
 // whatever the number of workers (results must not depend on it).
 extern "C" void openblas_set_num_threads(int);
 
-SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
-                          const std::function<SdpSummary(const LmiProblem&)>& solve) {
+SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem, const CanonicalSolve& solve) {
   openblas_set_num_threads(1);
   std::string error;
-  if (!options.IsValid(&error) || !problem.IsValid(&error)) {
+  if (options.IsValid(&error) && problem.IsValid(&error) && !options.initial_y.empty() &&
+      static_cast<int>(options.initial_y.size()) != problem.num_vars())
+    error = fmt::format("initial_y has {} values for {} variables", options.initial_y.size(), problem.num_vars());
+  if (!error.empty()) {
     SdpSummary out;
     out.status = SdpStatus::kInvalidProblem;
     out.message = error;
@@ -242,7 +248,12 @@ SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
     reduced.c.push_back(problem.c[i - 1]);
     reduced.F.push_back(std::move(Fi));
   }
-  SdpSummary out = reduced.num_vars() == 0 ? DecideConstantLmi(reduced) : solve(reduced);
+  SdpOptions reduced_options = options;
+  if (!options.initial_y.empty()) {
+    reduced_options.initial_y.clear();
+    for (int k : kept) reduced_options.initial_y.push_back(options.initial_y[k]);
+  }
+  SdpSummary out = reduced.num_vars() == 0 ? DecideConstantLmi(reduced) : solve(reduced_options, reduced);
   if (reduced.num_vars() == 0) {
     out.lower_bound += problem.objective_offset;
     out.primal_value += problem.objective_offset;
@@ -269,9 +280,10 @@ SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
 std::unique_ptr<SdpSolver> MakeSolver(const std::string& name) {
   if (name == "csdp") return std::make_unique<CsdpSolver>();
   if (name == "sdpa") return std::make_unique<SdpaSolver>();
-  throw std::invalid_argument("unknown SDP solver '" + name + "'; available: csdp, sdpa");
+  if (name == "dsdp") return std::make_unique<DsdpSolver>();
+  throw std::invalid_argument("unknown SDP solver '" + name + "'; available: csdp, sdpa, dsdp");
 }
 
-std::vector<std::string> AvailableSolvers() { return {"csdp", "sdpa"}; }
+std::vector<std::string> AvailableSolvers() { return {"csdp", "sdpa", "dsdp"}; }
 
 }  // namespace hw::sdp

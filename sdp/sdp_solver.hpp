@@ -1,5 +1,5 @@
 #pragma once
-// One small interface for interchangeable SDP backends (CSDP, SDPA), in the manner of Ceres:
+// One small interface for interchangeable SDP backends (CSDP, SDPA, DSDP), in the manner of Ceres:
 // options are a plain struct with defaults and IsValid(), the outcome is a summary with an explicit
 // status and message, and each backend's own details travel beside the common result.
 #include <functional>
@@ -32,7 +32,8 @@ struct SdpOptions {
   // (small POPs that stopped at pdFEAS/dFEAS finish that way). Callers with their own fallback chain turn it
   // off: on large ill-conditioned LMIs the second attempt mostly fails too and doubles the cost.
   bool retry_with_default_parameters = true;
-  // A warm start where the backend takes one (empty = none): an initial y, e.g. the previous round's solution.
+  // A warm start where the backend takes one (DSDP: its initial y; CSDP and SDPA ignore it). Empty = none;
+  // otherwise one value per variable of the problem as posed.
   std::vector<double> initial_y;
   bool IsValid(std::string* error) const;
 };
@@ -74,9 +75,10 @@ struct SdpSummary {
   }
 };
 
-// Solve() may be called from several threads at once (each call owns its data), but both libraries keep
+// Solve() may be called from several threads at once (each call owns its data), but all three libraries keep
 // process-wide state, so each backend serialises its solver calls with a process-wide mutex (see
-// csdp_backend.cpp / sdpa_backend.cpp and docs/sdp.md): concurrency pays off for the work around solves.
+// csdp_backend.cpp / sdpa_backend.cpp / dsdp_backend.cpp and docs/sdp.md): concurrency pays off for the work
+// around solves.
 class SdpSolver {
  public:
   virtual ~SdpSolver() = default;
@@ -84,6 +86,8 @@ class SdpSolver {
   virtual SdpSummary Solve(const SdpOptions& options, const LmiProblem& problem) = 0;
 };
 
+// F . X for one matrix of the problem (upper-triangular entries; off-diagonal ones count twice) and a block X.
+double InnerProduct(const std::vector<Entry>& F, const std::vector<Eigen::MatrixXd>& X);
 // sum_i |F_i . X| / F_0 . X for a candidate certificate X (infinity when X is not PSD or F_0 . X <= 0).
 double InfeasibilityResidual(const LmiProblem& problem, const std::vector<Eigen::MatrixXd>& X);
 // Turns a backend's infeasibility claim into kInfeasible (certificate checked) or kNumericalTrouble.
@@ -101,21 +105,22 @@ void ResolveInfeasibilityClaim(const SdpOptions& options, const LmiProblem& prob
 // Promotes kInaccurate to kOptimal when the gap and infeasibilities are within options.acceptable_gap.
 void AcceptNearOptimal(const SdpOptions& options, SdpSummary* summary);
 
-// Backend plumbing shared by CSDP and SDPA. Both choke on a variable whose F_i is zero (CSDP even calls
-// exit()), and duplicate entries mean different things to different solvers, so every backend solves the
-// canonical reduced problem: duplicates summed, zeros dropped, variables with F_i = 0 removed.
-// SolveCanonical() does that, solves with `solve`, and maps y back (removed variables get y_i = 0; a
-// removed variable with c_i != 0 makes a feasible problem unbounded). A problem left without variables is
-// decided directly: F(y) = -F_0 >= 0 or not (an eigenvector of -F_0 certifies infeasibility).
-SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem,
-                          const std::function<SdpSummary(const LmiProblem&)>& solve);
+// Backend plumbing shared by every backend. CSDP and SDPA choke on a variable whose F_i is zero (CSDP even
+// calls exit()), and duplicate entries mean different things to different solvers, so every backend solves
+// the canonical reduced problem: duplicates summed, zeros dropped, variables with F_i = 0 removed.
+// SolveCanonical() does that, solves with `solve` (given the options as they apply to the reduced problem:
+// initial_y restricted to the kept variables), and maps y back (removed variables get y_i = 0; a removed
+// variable with c_i != 0 makes a feasible problem unbounded). A problem left without variables is decided
+// directly: F(y) = -F_0 >= 0 or not (an eigenvector of -F_0 certifies infeasibility).
+using CanonicalSolve = std::function<SdpSummary(const SdpOptions& reduced_options, const LmiProblem& reduced)>;
+SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem, const CanonicalSolve& solve);
 // SolveCanonical, then the steps every backend shares: name the solver and drop X, Z unless kept.
 SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, const LmiProblem& problem,
-                          const std::function<SdpSummary(const LmiProblem&)>& solve);
+                          const CanonicalSolve& solve);
 // Relative duality gap as both backends report it: |p - d| / max(1, (|p| + |d|) / 2).
 double RelativeGap(double primal, double dual);
 
-// "csdp" or "sdpa"; throws std::invalid_argument for other names.
+// "csdp", "sdpa" or "dsdp"; throws std::invalid_argument for other names.
 std::unique_ptr<SdpSolver> MakeSolver(const std::string& name);
 std::vector<std::string> AvailableSolvers();
 

@@ -164,10 +164,10 @@ SdpSummary SdpaSolver::Solve(const SdpOptions& options, const LmiProblem& proble
   // (the same problem stopped at pdFEAS 4e-6 short of the gap on one machine and was optimal on another). A
   // solve that ends neither optimal nor with a certified infeasible/unbounded outcome is repeated with SDPA's
   // default parameter set; the first decided outcome wins, otherwise the first attempt is returned.
-  return SolveAsBackend(name(), options, problem, [&](const LmiProblem& p) {
-    SdpSummary first = SolveWithSdpa(options, p, SDPA::PARAMETER_STABLE_BUT_SLOW);
-    if (first.decided() || !options.retry_with_default_parameters) return first;
-    SdpSummary second = SolveWithSdpa(options, p, SDPA::PARAMETER_DEFAULT);
+  return SolveAsBackend(name(), options, problem, [](const SdpOptions& o, const LmiProblem& p) {
+    SdpSummary first = SolveWithSdpa(o, p, SDPA::PARAMETER_STABLE_BUT_SLOW);
+    if (first.decided() || !o.retry_with_default_parameters) return first;
+    SdpSummary second = SolveWithSdpa(o, p, SDPA::PARAMETER_DEFAULT);
     second.setup_seconds += first.setup_seconds + first.solve_seconds;  // the time of both attempts counts
     second.iterations += first.iterations;
     if (second.decided()) {

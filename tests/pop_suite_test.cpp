@@ -1,7 +1,7 @@
 // Classic polynomial optimisation problems with known global optima (from the literature, not from our
 // own output): at every order the bound is <= the optimum + tol and nondecreasing in the order; where
 // the optimum is reached the flatness check says so and the extracted minimizers match; infeasible
-// problems are reported infeasible; CSDP and SDPA agree within 1e-6 relative.
+// problems are reported infeasible; CSDP, SDPA and DSDP agree within 1e-5 relative.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -74,7 +74,24 @@ TEST(PopSuite, KnownOptimaAreConsistent) {
   }
 }
 
-void RunCase(const Case& c, const std::string& solver_name) {
+// DSDP keeps its dual iterate strictly inside the LMI and builds X from the barrier. Where the LMI has no interior
+// (the equality-constrained cases: their moment matrices are singular for every y), X grows along the common null
+// directions of the F_i (trace 4.3e7, against CSDP's 12.5, on circle_linear order 2) and the solve misses the
+// tolerances (kInaccurate; y is still accurate and the X bound below the optimum) or breaks down (line_quartic
+// order 3: indefinite Schur matrix). Either way it must say so, and no bound is reported.
+bool FailedWithoutInterior(const Case& c, const RelaxationResult& r, bool may_fail_without_interior) {
+  return may_fail_without_interior && !c.equalities.empty() && r.status == RelaxationStatus::kSolverFailed;
+}
+
+void ExpectHonestFailure(const Case& c, int order, const RelaxationResult& r) {
+  ASSERT_TRUE(r.sdp.status == sdp::SdpStatus::kInaccurate || r.sdp.status == sdp::SdpStatus::kNumericalTrouble);
+  if (r.sdp.status != sdp::SdpStatus::kInaccurate) return;
+  const double tol = 1e-5 * std::max(1.0, std::abs(c.optimum));
+  EXPECT_LE(r.sdp.lower_bound, c.optimum + tol);
+  if (order >= c.exact_from_order) EXPECT_NEAR(r.sdp.primal_value, c.optimum, tol);
+}
+
+void RunCase(const Case& c, const std::string& solver_name, bool may_fail_without_interior = false) {
   const auto p = Build(c);
   auto solver = sdp::MakeSolver(solver_name);
   double previous = -INFINITY;
@@ -84,6 +101,10 @@ void RunCase(const Case& c, const std::string& solver_name) {
     const auto r = SolveRelaxation(opt, p, *solver);
     SCOPED_TRACE(c.name + " order " + std::to_string(order) + " " + solver_name + ": " + r.message);
     if (r.status == RelaxationStatus::kUnbounded) continue;  // -infinity is a valid (trivial) lower bound
+    if (FailedWithoutInterior(c, r, may_fail_without_interior)) {
+      ExpectHonestFailure(c, order, r);
+      continue;
+    }
     ASSERT_EQ(r.status, RelaxationStatus::kSolved);
     const double tol = 1e-5 * std::max(1.0, std::abs(c.optimum));
     EXPECT_LE(r.bound, c.optimum + tol);
@@ -114,17 +135,28 @@ TEST(PopSuite, CsdpBoundsAndMinimizers) {
   for (const auto& c : Suite()) RunCase(c, "csdp");
 }
 
-TEST(PopSuite, CsdpAndSdpaAgree) {
-  auto csdp = sdp::MakeSolver("csdp");
-  auto sdpa = sdp::MakeSolver("sdpa");
+TEST(PopSuite, DsdpBoundsAndMinimizers) {
+  for (const auto& c : Suite()) RunCase(c, "dsdp", true);
+}
+
+// Two backends: same status, bounds within 1e-5 relative (where `first` failed without interior but ended
+// kInaccurate, its y-side value).
+void ExpectBackendsAgree(const std::string& first, const std::string& second, bool may_fail_without_interior = false) {
+  auto s1 = sdp::MakeSolver(first);
+  auto s2 = sdp::MakeSolver(second);
   for (const auto& c : Suite()) {
     const auto p = Build(c);
     for (int order : c.orders) {
       RelaxationOptions opt;
       opt.order = order;
-      const auto a = SolveRelaxation(opt, p, *csdp);
-      const auto b = SolveRelaxation(opt, p, *sdpa);
-      SCOPED_TRACE(c.name + " order " + std::to_string(order));
+      const auto a = SolveRelaxation(opt, p, *s1);
+      const auto b = SolveRelaxation(opt, p, *s2);
+      SCOPED_TRACE(c.name + " order " + std::to_string(order) + ": " + first + " vs " + second);
+      if (FailedWithoutInterior(c, a, may_fail_without_interior) && b.status == RelaxationStatus::kSolved) {
+        if (a.sdp.status == sdp::SdpStatus::kInaccurate)
+          EXPECT_NEAR(a.sdp.primal_value, b.bound, 1e-5 * std::max(1.0, std::abs(b.bound)));
+        continue;
+      }
       ASSERT_EQ(a.status, b.status) << a.message << " | " << b.message;
       // 1e-5 relative: both stop at relative gap and infeasibility 1e-7, and with moments up to ~1e2 the
       // bounds can differ by ~1e-5 (measured 8.6e-6 on gloptipoly_constrained order 2, where SDPA's stable
@@ -133,6 +165,13 @@ TEST(PopSuite, CsdpAndSdpaAgree) {
         EXPECT_NEAR(a.bound, b.bound, 1e-5 * std::max(1.0, std::abs(a.bound)));
     }
   }
+}
+
+TEST(PopSuite, CsdpAndSdpaAgree) { ExpectBackendsAgree("csdp", "sdpa"); }
+
+TEST(PopSuite, DsdpAgreesWithCsdpAndSdpa) {
+  ExpectBackendsAgree("dsdp", "csdp", true);
+  ExpectBackendsAgree("dsdp", "sdpa", true);
 }
 
 TEST(PopSuite, MotzkinWithoutConstraintsHasNoSosBound) {
@@ -155,7 +194,7 @@ TEST(PopSuite, InfeasibleProblemIsReportedInfeasible) {
   p.num_vars = 2;
   p.objective = parse_polynomial("x1 + x2", {"x1", "x2"});
   p.inequalities = {parse_polynomial("1 - x1^2 - x2^2", {"x1", "x2"}), parse_polynomial("x1 - 2", {"x1", "x2"})};
-  for (const std::string name : {"csdp", "sdpa"}) {
+  for (const std::string name : {"csdp", "sdpa", "dsdp"}) {
     auto solver = sdp::MakeSolver(name);
     for (int order : {1, 2}) {
       RelaxationOptions opt;
