@@ -229,7 +229,10 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     } else if (r.status == RelaxationStatus::kSolved) {
       out.status = "solved";
       out.float_bound = set.scaling().to_original(obj.param, r.float_bound);
-      out.bound = set.scaling().to_original(obj.param, r.bound);
+      // Every parameter lies in the job's box (scaled [-1, 1]), so a bound weaker than its edge (the verified
+      // bound of an unfinished iterate can be) is replaced by the edge: still valid.
+      const double scaled = obj.dir < 0 ? std::max(r.bound, -1.0) : std::min(r.bound, 1.0);
+      out.bound = set.scaling().to_original(obj.param, scaled);
       if (r.verification.verified()) {
         // The affine map back to original units rounds twice: widen outward by a few ulps of its terms.
         const auto [lo, hi] = set.box()[obj.param];

@@ -169,6 +169,7 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
   };
 
   std::vector<double> warm_y;
+  int failed_in_a_row = 0;
   for (int round = 1; round <= options.max_rounds; ++round) {
     result.rounds = round;
     GenerationRound report;
@@ -251,19 +252,30 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     } else {
       offer(round, sdp, nullptr, sign);
     }
-    if (sdp.status != sdp::SdpStatus::kOptimal) {
+    const bool solved = sdp.status == sdp::SdpStatus::kOptimal;
+    // A round that stops short still points at violated blocks (its last iterate); after two such rounds in a
+    // row, or without an iterate, the job ends with the best verified bound so far.
+    failed_in_a_row = solved ? 0 : failed_in_a_row + 1;
+    const std::string stop_reason =
+        fmt::format("round {}: {}: {} ({})", round, sdp.solver, sdp::ToString(sdp.status), sdp.message);
+    if (!solved && (failed_in_a_row >= 2 || sdp.y.size() != relaxation.lmi().c.size() || round == options.max_rounds)) {
       announce(-1);
-      return finish(false, fmt::format("round {}: {}: {} ({})", round, sdp.solver, sdp::ToString(sdp.status),
-                                       sdp.message));
+      return finish(false, stop_reason);
     }
-    warm_y = sdp.y;
-    result.last_y = sdp.y;
+    if (solved) {
+      warm_y = sdp.y;
+      result.last_y = sdp.y;
+    }
     const auto y = relaxation.moments(sdp.y);
-    result.first_moments.assign(y.begin() + 1, y.begin() + 1 + core.num_vars);
+    if (solved) result.first_moments.assign(y.begin() + 1, y.begin() + 1 + core.num_vars);
     const auto [violated, worst] = ViolatedBlocks(relaxation, candidates, blocks, y, options.violation_tolerance);
     result.max_violation = worst;
-    const bool converged = violated.empty();
-    if (converged || round == options.max_rounds) {
+    if (!solved && violated.empty()) {  // nothing to add, and the moments of an unfinished solve prove nothing
+      announce(0);
+      return finish(false, stop_reason);
+    }
+    const bool converged = solved && violated.empty();
+    if (solved && (converged || round == options.max_rounds)) {
       // The bound that is reported: verify the final round with re-solves when the plain check was loose.
       if (verify) {
         auto v = sdp::VerifyOptimalSolve(options.verify, sdp_options, relaxation.lmi(), bounds, sdp, *used);
