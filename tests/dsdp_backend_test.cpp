@@ -263,6 +263,38 @@ TEST(DsdpBackend, VerbosePrintsTheIterationLog) {
   EXPECT_NE(printed.find("PP Objective"), std::string::npos) << printed;
 }
 
+// Nothing on stdout without verbose, whatever the outcome (DSDP prints only tracebacks of failed calls).
+TEST(DsdpBackend, QuietOnEveryOutcome) {
+  LmiProblem unbounded;
+  unbounded.blocks = {{Kind::kPsd, 2}};
+  unbounded.c = {-1.0, -1.0};
+  unbounded.F.resize(3);
+  unbounded.add(1, 0, 0, 0, 1.0);
+  unbounded.add(2, 0, 1, 1, 1.0);
+  unbounded.add(0, 0, 0, 1, -1.0);
+  // min x1^4 + x2^2 on the line x1 + x2 = 1, order 3: no interior, DSDP breaks down (indefinite Schur matrix).
+  const std::vector<std::string> v = {"x1", "x2"};
+  relax::PolyProblem line;
+  line.num_vars = 2;
+  line.names = v;
+  line.objective = parse_polynomial("x1^4 + x2^2", v);
+  line.equalities = {parse_polynomial("x1 + x2 - 1", v)};
+  relax::MomentRelaxation no_interior(line, 3);
+  SdpOptions capped;
+  capped.max_iterations = 2;
+  testing::internal::CaptureStdout();
+  const auto a = SolveWith("dsdp", InfeasibleMixedLmi());
+  const auto b = SolveWith("dsdp", unbounded);
+  const auto c = SolveWith("dsdp", MaxEigenvalueInABox(3, 5, 3), capped);
+  const auto d = SolveWith("dsdp", no_interior.lmi());
+  const std::string printed = testing::internal::GetCapturedStdout();
+  EXPECT_EQ(printed, "");
+  EXPECT_EQ(a.status, SdpStatus::kInfeasible);
+  EXPECT_EQ(b.status, SdpStatus::kUnbounded);
+  EXPECT_EQ(c.status, SdpStatus::kIterationLimit);
+  EXPECT_FALSE(d.usable()) << d.message;
+}
+
 // A set-membership relaxation of the paper-001 example (n = 1, order 1, true orthant, min a1, 40 data
 // inequalities): the three backends agree on the bound.
 TEST(DsdpBackend, AgreesOnASetMembershipRelaxation) {
