@@ -2,9 +2,10 @@
 // CSDP and SDPA on mixed PSD/LP problems and on a set-membership relaxation of the paper-001 example,
 // certificates of infeasibility and unboundedness checked independently, LP-only problems (with a row that
 // carries no data), the multiplier turned into a rigorous bound (also after a solve stopped short), the warm
-// start, and the iteration log under verbose.
+// start, the iteration log under verbose, and the set-membership engine run with DSDP.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -13,6 +14,7 @@
 #include "relax/constraint_generation.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "relax/moment_relaxation.hpp"
+#include "relax/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 #include "sdp/sdpa_format.hpp"
 #include "sdp/verified_bound.hpp"
@@ -261,6 +263,38 @@ TEST(DsdpBackend, VerbosePrintsTheIterationLog) {
   EXPECT_NE(printed.find("PP Objective"), std::string::npos) << printed;
 }
 
+// Nothing on stdout without verbose, whatever the outcome (DSDP prints only tracebacks of failed calls).
+TEST(DsdpBackend, QuietOnEveryOutcome) {
+  LmiProblem unbounded;
+  unbounded.blocks = {{Kind::kPsd, 2}};
+  unbounded.c = {-1.0, -1.0};
+  unbounded.F.resize(3);
+  unbounded.add(1, 0, 0, 0, 1.0);
+  unbounded.add(2, 0, 1, 1, 1.0);
+  unbounded.add(0, 0, 0, 1, -1.0);
+  // min x1^4 + x2^2 on the line x1 + x2 = 1, order 3: no interior, DSDP breaks down (indefinite Schur matrix).
+  const std::vector<std::string> v = {"x1", "x2"};
+  relax::PolyProblem line;
+  line.num_vars = 2;
+  line.names = v;
+  line.objective = parse_polynomial("x1^4 + x2^2", v);
+  line.equalities = {parse_polynomial("x1 + x2 - 1", v)};
+  relax::MomentRelaxation no_interior(line, 3);
+  SdpOptions capped;
+  capped.max_iterations = 2;
+  testing::internal::CaptureStdout();
+  const auto a = SolveWith("dsdp", InfeasibleMixedLmi());
+  const auto b = SolveWith("dsdp", unbounded);
+  const auto c = SolveWith("dsdp", MaxEigenvalueInABox(3, 5, 3), capped);
+  const auto d = SolveWith("dsdp", no_interior.lmi());
+  const std::string printed = testing::internal::GetCapturedStdout();
+  EXPECT_EQ(printed, "");
+  EXPECT_EQ(a.status, SdpStatus::kInfeasible);
+  EXPECT_EQ(b.status, SdpStatus::kUnbounded);
+  EXPECT_EQ(c.status, SdpStatus::kIterationLimit);
+  EXPECT_FALSE(d.usable()) << d.message;
+}
+
 // A set-membership relaxation of the paper-001 example (n = 1, order 1, true orthant, min a1, 40 data
 // inequalities): the three backends agree on the bound.
 TEST(DsdpBackend, AgreesOnASetMembershipRelaxation) {
@@ -287,6 +321,37 @@ TEST(DsdpBackend, AgreesOnASetMembershipRelaxation) {
   const auto v = VerifyLowerBound(r.lmi(), d.X, relax::MomentVariableBounds(p, r), d.lower_bound);
   ASSERT_TRUE(v.verified()) << v.message;
   EXPECT_GE(v.bound, d.lower_bound - 1e-6);
+}
+
+// The set-membership engine takes "dsdp" and gives CSDP's intervals on a small seeded instance of the paper-001
+// example (N = 30, n = 1, order 1), the truth inside.
+TEST(DsdpBackend, SetMembershipEngineRunsWithDsdp) {
+  std::string error;
+  relax::BoundsOptions options;
+  options.solver = "mosek";
+  EXPECT_FALSE(options.IsValid(&error));
+  options.solver = "dsdp";
+  ASSERT_TRUE(options.IsValid(&error)) << error;
+  const auto ex = SimulateCeroneExample(9, 30, 31.0);
+  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  relax::HwOuterSet set(relax::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10, 10}));
+  options.order = 1;
+  options.threads = 2;
+  options.retry_with_other_solver = false;
+  const auto d = relax::ComputeBounds(options, set);
+  options.solver = "csdp";
+  const auto c = relax::ComputeBounds(options, set);
+  ASSERT_EQ(d.intervals.size(), c.intervals.size());
+  const auto truth = CeroneExample::TrueParameters();
+  for (std::size_t k = 0; k < d.intervals.size(); ++k) {
+    EXPECT_NEAR(d.intervals[k].lower.value, c.intervals[k].lower.value, 1e-4) << d.intervals[k].name;
+    EXPECT_NEAR(d.intervals[k].upper.value, c.intervals[k].upper.value, 1e-4) << d.intervals[k].name;
+    const auto& names = d.parameter_names;
+    const std::size_t t = std::find(names.begin(), names.end(), d.intervals[k].name) - names.begin();
+    ASSERT_LT(t, truth.size());
+    EXPECT_LE(d.intervals[k].lower.value, truth[t] + 1e-6) << d.intervals[k].name;
+    EXPECT_GE(d.intervals[k].upper.value, truth[t] - 1e-6) << d.intervals[k].name;
+  }
 }
 
 }  // namespace
