@@ -106,9 +106,10 @@ class MatFile {
     matio_last_message.clear();
     mat_ = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
     if (!mat_)
-      throw InputError(fmt::format("{}: not a MATLAB .mat file that libmatio can read (v4, v5, v7 or v7.3){}; "
-                                   "save it with MATLAB's save(...) or scipy.io.savemat",
-                                   path, MatioDetail()));
+      throw InputError(
+          fmt::format("{}: not a MATLAB .mat file that libmatio can read (v4, v5, v7 or v7.3){}; "
+                      "save it with MATLAB's save(...) or scipy.io.savemat",
+                      path, MatioDetail()));
   }
   ~MatFile() { Mat_Close(mat_); }
   MatFile(const MatFile&) = delete;
@@ -134,8 +135,7 @@ class MatFile {
   std::vector<double> ReadVector(const std::string& name) {
     VarPtr info(Mat_VarReadInfo(mat_, name.c_str()));
     matio_last_message.clear();
-    if (!info)
-      throw InputError(fmt::format("{}: no variable '{}'; the file has: {}", path_, name, Listing()));
+    if (!info) throw InputError(fmt::format("{}: no variable '{}'; the file has: {}", path_, name, Listing()));
     CheckVector(*info, name);
     VarPtr var(Mat_VarRead(mat_, name.c_str()));
     if (!var || !var->data)
@@ -152,10 +152,11 @@ class MatFile {
   void CheckVector(const matvar_t& v, const std::string& name) const {
     const std::string what = fmt::format("{}: variable '{}' is a {} {} array", path_, name, Shape(v), ClassName(v));
     if (v.class_type == MAT_C_EMPTY && Elements(v) > 0)  // data, but no class libmatio recognises
-      throw InputError(fmt::format("{}: variable '{}' ({}) has no MATLAB class that libmatio recognises; in a v7.3 "
-                                   "(HDF5) file every dataset needs a MATLAB_class attribute such as 'double', "
-                                   "written null-terminated as MATLAB writes it",
-                                   path_, name, Shape(v)));
+      throw InputError(
+          fmt::format("{}: variable '{}' ({}) has no MATLAB class that libmatio recognises; in a v7.3 "
+                      "(HDF5) file every dataset needs a MATLAB_class attribute such as 'double', "
+                      "written null-terminated as MATLAB writes it",
+                      path_, name, Shape(v)));
     if (v.isLogical || !IsNumericClass(v.class_type))
       throw InputError(what + "; a recording variable must be numeric (double, single or integer)");
     if (v.isComplex) throw InputError(what + " of complex numbers; a recording variable must be real");
@@ -181,9 +182,10 @@ CsvTable read_mat_columns(const std::string& path, const std::vector<MatColumn>&
   for (const auto& c : columns) {
     auto values = file.ReadVector(c.variable);
     if (!table.columns.empty() && values.size() != table.rows())
-      throw InputError(fmt::format("{}: variable '{}' has {} samples but '{}' has {}; the variables of one recording "
-                                   "must have the same length",
-                                   path, c.variable, values.size(), first, table.rows()));
+      throw InputError(
+          fmt::format("{}: variable '{}' has {} samples but '{}' has {}; the variables of one recording "
+                      "must have the same length",
+                      path, c.variable, values.size(), first, table.rows()));
     if (table.columns.empty()) first = c.variable;
     table.add_column(c.column, std::move(values));
   }

@@ -72,10 +72,11 @@ CsvTable ReadMat(const RecordingSpec& spec, const std::vector<std::string>& requ
     if (std::find(names.begin(), names.end(), column) != names.end()) {
       columns.push_back({column, column});
     } else if (is_required) {
-      throw InputError(fmt::format("{}: no variable '{}' for the column {}; name its variable as {}:{}=VARIABLE "
-                                   "(the file has: {})",
-                                   spec.path, column, column, spec.path, column,
-                                   names.empty() ? "no variables" : fmt::format("{}", fmt::join(names, ", "))));
+      throw InputError(
+          fmt::format("{}: no variable '{}' for the column {}; name its variable as {}:{}=VARIABLE "
+                      "(the file has: {})",
+                      spec.path, column, column, spec.path, column,
+                      names.empty() ? "no variables" : fmt::format("{}", fmt::join(names, ", "))));
     }
   };
   for (const auto& c : required) add(c, true);
@@ -85,13 +86,14 @@ CsvTable ReadMat(const RecordingSpec& spec, const std::vector<std::string>& requ
 
 CsvTable ReadCsv(const RecordingSpec& spec, const std::vector<std::string>& required) {
   CsvTable table = read_csv(spec.path);
-  for (const auto& m : spec.map) {
-    std::vector<double> values = table.column(m.variable);
-    const auto at = std::find(table.names.begin(), table.names.end(), m.column);
+  std::vector<std::vector<double>> mapped;  // every source column is read before any is replaced (u=y,y=u)
+  for (const auto& m : spec.map) mapped.push_back(table.column(m.variable));
+  for (std::size_t i = 0; i < spec.map.size(); ++i) {
+    const auto at = std::find(table.names.begin(), table.names.end(), spec.map[i].column);
     if (at != table.names.end())
-      table.columns[at - table.names.begin()] = std::move(values);
+      table.columns[at - table.names.begin()] = std::move(mapped[i]);
     else
-      table.add_column(m.column, std::move(values));
+      table.add_column(spec.map[i].column, std::move(mapped[i]));
   }
   for (const auto& c : required) table.column(c);  // throws naming the header when absent
   return table;

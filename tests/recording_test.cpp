@@ -40,8 +40,8 @@ void WriteMat(const std::string& path, mat_ft version, const std::vector<Var>& v
   ASSERT_NE(mat, nullptr) << path;
   for (const auto& v : vars) {
     std::vector<std::size_t> dims = v.dims;
-    matvar_t* m = Mat_VarCreate(v.name.c_str(), v.cls, v.type, static_cast<int>(dims.size()), dims.data(), v.data,
-                                v.flags);
+    matvar_t* m =
+        Mat_VarCreate(v.name.c_str(), v.cls, v.type, static_cast<int>(dims.size()), dims.data(), v.data, v.flags);
     ASSERT_NE(m, nullptr) << v.name;
     ASSERT_EQ(Mat_VarWrite(mat, m, MAT_COMPRESSION_NONE), 0) << v.name;
     Mat_VarFree(m);
@@ -92,7 +92,8 @@ TEST(MatRecording, LibmatioV73AndV5FilesReadLikeTheirCsvTwin) {
   auto t = csv.column("t"), u = csv.column("u"), y = csv.column("y");
   for (mat_ft version : {MAT_FT_MAT73, MAT_FT_MAT5}) {
     const std::string path = Temp(version == MAT_FT_MAT73 ? "libmatio73.mat" : "libmatio5.mat");
-    WriteMat(path, version, {Column("t", t), Column("u", u), {"y", MAT_C_DOUBLE, MAT_T_DOUBLE, {1, y.size()}, y.data()}});
+    WriteMat(path, version,
+             {Column("t", t), Column("u", u), {"y", MAT_C_DOUBLE, MAT_T_DOUBLE, {1, y.size()}, y.data()}});
     // No map: the variables carry the column names.
     ExpectSameSamples(read_recording(path, {"u", "y"}, {"t"}), csv, {"t", "u", "y"});
   }
@@ -213,7 +214,8 @@ TEST(MatRecordingErrors, NonFiniteSampleIsNamedByIndex) {
   for (mat_ft version : {MAT_FT_MAT5, MAT_FT_MAT73}) {
     const std::string path = Temp(version == MAT_FT_MAT5 ? "nan5.mat" : "nan73.mat");
     WriteMat(path, version, {Column("u", u), Column("y", y)});
-    EXPECT_HAS(ErrorOf([&] { read_recording(path, {"u"}); }), path + ": variable 'u' sample 3 is nan; every sample must be a finite number");
+    EXPECT_HAS(ErrorOf([&] { read_recording(path, {"u"}); }),
+               path + ": variable 'u' sample 3 is nan; every sample must be a finite number");
     EXPECT_HAS(ErrorOf([&] { read_recording(path + ":u=y", {"u"}); }), "variable 'y' sample 4 is inf");
   }
 }
@@ -275,7 +277,8 @@ TEST(RecordingSpec, CsvColumnsCanBeMappedToo) {
   const auto csv = read_csv(kData + "/recording.csv");
   EXPECT_EQ(table.column("u"), csv.column("y"));
   EXPECT_EQ(table.column("y"), csv.column("u"));
-  EXPECT_HAS(ErrorOf([] { read_recording(kData + "/recording.csv", {"w"}); }), "no column 'w'; the header has: t, u, y");
+  EXPECT_HAS(ErrorOf([] { read_recording(kData + "/recording.csv", {"w"}); }),
+             "no column 'w'; the header has: t, u, y");
   EXPECT_HAS(ErrorOf([] { read_recording(kData + "/recording.csv:u=vir", {"u"}); }), "no column 'vir'");
 }
 
@@ -289,7 +292,9 @@ TEST(MatRecordingCli, SimulateReadsTheMatFileLikeTheCsv) {
     "output_nonlinearity": {"kind": "identity"}})";
   const std::string cli = std::string(HW_CLI_PATH) + " simulate --model " + model + " --input ";
   ASSERT_EQ(std::system((cli + kData + "/recording.csv --out " + Temp("from_csv.csv") + " > /dev/null").c_str()), 0);
-  ASSERT_EQ(std::system((cli + kData + "/recording_v73.mat:u=vir --out " + Temp("from_mat.csv") + " > /dev/null").c_str()), 0);
+  ASSERT_EQ(
+      std::system((cli + kData + "/recording_v73.mat:u=vir --out " + Temp("from_mat.csv") + " > /dev/null").c_str()),
+      0);
   const auto a = read_csv(Temp("from_csv.csv")), b = read_csv(Temp("from_mat.csv"));
   EXPECT_EQ(a.column("w"), b.column("w"));
   const std::string bad = cli + kData + "/recording_v5.mat:u=nope --out " + Temp("bad.csv") + " 2> " + Temp("bad.err");
