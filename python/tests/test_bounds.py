@@ -7,6 +7,7 @@ import textwrap
 
 import numpy as np
 import pytest
+import scipy.io
 
 import hwbounds
 from conftest import CERONE_N300, cli_error, load_json, run_cli, without
@@ -36,6 +37,18 @@ def test_same_result_as_the_cli(recording, tmp_path):
     assert py["intervals"][0]["lower"]["status"] == "guaranteed"
     assert py["intervals"][0]["lower"]["value"] < py["intervals"][0]["upper"]["value"]
     assert without(py, "timing") == without(cli, "timing")
+
+
+def test_cli_bounds_from_a_mat_file_equal_those_from_the_csv(recording, tmp_path):
+    path, rec = recording
+    mat = tmp_path / "rec.mat"
+    scipy.io.savemat(mat, {"vir": rec["u"], "qm": rec["y"].reshape(-1, 1), "dy": rec["noise_bound"]})
+    common = ("--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--params", "a1", "--solver", "csdp",
+              "--threads", 2, "--quiet")
+    run_cli("bounds", "--data", path, *common, "--json", tmp_path / "csv.json")
+    run_cli("bounds", "--data", f"{mat}:u=vir,y=qm,noise_bound=dy", *common, "--json", tmp_path / "mat.json")
+    assert without(load_json(tmp_path / "mat.json"), "timing", "data") == \
+        without(load_json(tmp_path / "csv.json"), "timing", "data")
 
 
 def test_validation_errors_carry_the_cli_message(recording):
