@@ -45,12 +45,6 @@ std::vector<MatColumn> ParseMap(const std::string& text, const std::string& spec
   return map;
 }
 
-std::string Describe(const std::vector<std::string>& required, const std::vector<std::string>& optional) {
-  std::string s = fmt::format("{}", fmt::join(required, ", "));
-  if (!optional.empty()) s += fmt::format("{}optionally {}", s.empty() ? "" : " and ", fmt::join(optional, ", "));
-  return s;
-}
-
 const MatColumn* Find(const std::vector<MatColumn>& map, const std::string& column) {
   for (const auto& m : map)
     if (m.column == column) return &m;
@@ -101,6 +95,12 @@ CsvTable ReadCsv(const RecordingSpec& spec, const std::vector<std::string>& requ
 
 }  // namespace
 
+std::string DescribeColumns(const std::vector<std::string>& required, const std::vector<std::string>& optional) {
+  std::string s = fmt::format("{}", fmt::join(required, ", "));
+  if (!optional.empty()) s += fmt::format("{}optionally {}", s.empty() ? "" : " and ", fmt::join(optional, ", "));
+  return s;
+}
+
 RecordingSpec RecordingSpec::Parse(const std::string& text) {
   RecordingSpec spec;
   const std::string lower = Lower(text);
@@ -123,7 +123,7 @@ CsvTable read_recording(const std::string& text, const std::vector<std::string>&
     if (std::find(required.begin(), required.end(), m.column) == required.end() &&
         std::find(optional.begin(), optional.end(), m.column) == optional.end())
       throw InputError(fmt::format("'{}': unknown column '{}'; this command reads {}", text, m.column,
-                                   Describe(required, optional)));
+                                   DescribeColumns(required, optional)));
   return spec.mat ? ReadMat(spec, required, optional) : ReadCsv(spec, required);
 }
 

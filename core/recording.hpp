@@ -29,4 +29,7 @@ struct RecordingSpec {
 CsvTable read_recording(const std::string& spec, const std::vector<std::string>& required,
                         const std::vector<std::string>& optional = {});
 
+// "u, y and optionally t": the columns a command reads, for messages.
+std::string DescribeColumns(const std::vector<std::string>& required, const std::vector<std::string>& optional);
+
 }  // namespace hw

@@ -93,11 +93,6 @@ py::array_t<double> ToArray(const std::vector<double>& v) {
 
 namespace {
 
-std::string Expected(const std::vector<std::string>& required, const std::vector<std::string>& optional) {
-  return fmt::format("{}{}", fmt::join(required, ", "),
-                     optional.empty() ? "" : fmt::format(" and optionally {}", fmt::join(optional, ", ")));
-}
-
 void AddChecked(CsvTable* table, const std::string& what, const std::string& name, std::vector<double> values) {
   if (!table->columns.empty() && values.size() != table->rows())
     throw py::value_error(
@@ -118,7 +113,7 @@ CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::v
     const auto items = h.cast<py::tuple>();
     if (items.size() < required.size() || items.size() > required.size() + optional.size())
       throw py::value_error(
-          fmt::format("{}: a tuple of {} arrays; expected ({})", what, items.size(), Expected(required, optional)));
+          fmt::format("{}: a tuple of {} arrays; expected ({})", what, items.size(), DescribeColumns(required, optional)));
     for (std::size_t i = 0; i < items.size(); ++i) {
       const auto& name = i < required.size() ? required[i] : optional[i - required.size()];
       AddChecked(&table, what, name, ToVector(items[i], fmt::format("{}[{}] ({})", what, i, name)));
@@ -129,19 +124,19 @@ CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::v
     throw py::type_error(
         fmt::format("{}: expected a recording spec string, a dict of arrays ({}) or a tuple of "
                     "arrays, got {}",
-                    what, Expected(required, optional), py::repr(h.get_type()).cast<std::string>()));
+                    what, DescribeColumns(required, optional), py::repr(h.get_type()).cast<std::string>()));
   const auto d = h.cast<py::dict>();
   for (const auto& [k, v] : d) {
     const std::string key = py::str(k);
     if (std::find(required.begin(), required.end(), key) == required.end() &&
         std::find(optional.begin(), optional.end(), key) == optional.end())
-      throw py::value_error(fmt::format("{}: unknown key '{}'; expected {}", what, key, Expected(required, optional)));
+      throw py::value_error(fmt::format("{}: unknown key '{}'; expected {}", what, key, DescribeColumns(required, optional)));
   }
   for (const auto* names : {&required, &optional})
     for (const auto& name : *names) {
       if (!d.contains(name)) {
         if (names == &required)
-          throw py::value_error(fmt::format("{}: no '{}'; expected {}", what, name, Expected(required, optional)));
+          throw py::value_error(fmt::format("{}: no '{}'; expected {}", what, name, DescribeColumns(required, optional)));
         continue;
       }
       AddChecked(&table, what, name, ToVector(d[py::str(name)], fmt::format("{}['{}']", what, name)));
