@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/recording.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 
@@ -71,7 +72,8 @@ void AddBoundsCommand(CLI::App& app) {
     int contraction_passes = 0;
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("--data", o->data, "recording CSV with a header")->required();
+  cmd->add_option("--data", o->data, "recording: CSV with a header, or FILE.mat:u=VAR,y=VAR (docs/recordings.md)")
+      ->required();
   cmd->add_option("--u-col", o->u_col, "input column");
   cmd->add_option("--y-col", o->y_col, "output column");
   cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value");
@@ -102,7 +104,9 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--json", o->json_out, "write the result as JSON");
   cmd->add_flag("--quiet", o->quiet, "no progress lines");
   cmd->callback([o] {
-    const CsvTable table = read_csv(o->data);
+    std::vector<std::string> columns = {o->u_col, o->y_col};
+    if (!o->noise_col.empty()) columns.push_back(o->noise_col);
+    const CsvTable table = read_recording(o->data, columns);
     relax::HwData data;
     data.source = o->data;
     data.u = table.column(o->u_col);

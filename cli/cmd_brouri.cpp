@@ -189,9 +189,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
       std::string hs;
       for (std::size_t i = est.h.size(); i-- > 1;) hs += fmt::format("{:+.6g} w^{} ", est.h[i], i);
       fmt::print("h^(w) = {}\n", hs);
-      result = est.to_json();
-      result["stage"] = "steps";
-      result["summary"] = s.message;
+      result = StepsResultJson(est, s);
     } else {
       const SinePlan plan = SinePlan::from_json(j);
       FrequencyOptions opt;
@@ -206,15 +204,10 @@ void AddBrouriEstimate(CLI::App& brouri) {
       }
       UnwrapPhases(&points);
       fmt::print("{:>10} {:>10} {:>12} {:>9} {:>9}\n", "omega", "|G^|", "phi^ (rad)", "harmonic", "misfit");
-      result["stage"] = "sines";
-      result["points"] = nlohmann::json::array();
-      for (const auto& p : points) {
+      for (const auto& p : points)
         fmt::print("{:>10.5g} {:>10.5f} {:>12.5f} {:>9} {:>9.2g}\n", p.omega, p.gain, p.phase, p.harmonic,
                    p.fit_residual);
-        result["points"].push_back(ToJson(p));
-      }
-      result["nonlinear"] = plan.nonlinear.to_json();
-      result["note"] = "normalised model (eq. 4): G(0) = 1, phi = -arg G";
+      result = SinesResultJson(plan, points);
     }
     write_text_atomic(o->out, result.dump(2) + "\n");
     fmt::print("wrote {}\n", o->out);

@@ -9,31 +9,6 @@
 #include "diagnose/diagnose.hpp"
 
 namespace hw::cli {
-namespace {
-
-diagnose::Recording LoadRecording(const std::string& path, const std::string& u_col, const std::string& y_col,
-                                  const std::string& t_col) {
-  const CsvTable tab = read_csv(path);
-  diagnose::Recording r;
-  r.name = path;
-  r.u = tab.column(u_col);
-  r.y = tab.column(y_col);
-  if (tab.has(t_col)) {
-    r.t = tab.column(t_col);
-    for (std::size_t i = 1; i < r.t.size(); ++i)
-      if (!(r.t[i] > r.t[i - 1]))
-        throw InputError(fmt::format("{}: column '{}' must increase strictly (data row {}: {} after {})", path, t_col,
-                                     i + 1, r.t[i], r.t[i - 1]));
-  } else {
-    r.t.resize(r.u.size());
-    for (std::size_t i = 0; i < r.t.size(); ++i) r.t[i] = static_cast<double>(i);
-  }
-  if (r.u.size() < 60)
-    throw InputError(fmt::format("{}: {} samples; the diagnosis needs at least 60", path, r.u.size()));
-  return r;
-}
-
-}  // namespace
 
 void AddDiagnoseCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -44,8 +19,9 @@ void AddDiagnoseCommand(CLI::App& app) {
     diagnose::DiagnoseOptions o;
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("--data", o->data, "identification recording (CSV with header)")->required();
-  cmd->add_option("--validate", o->validate, "validation recording (CSV with header)")->required();
+  cmd->add_option("--data", o->data, "identification recording (CSV with header, or FILE.mat:u=VAR,y=VAR[,t=VAR])")
+      ->required();
+  cmd->add_option("--validate", o->validate, "validation recording (CSV or .mat, as --data)")->required();
   auto* m = cmd->add_option("--model", o->model, "nominal model JSON (README: Model JSON)");
   auto* f = cmd->add_option("--fit", o->fit, "fit the nominal model first: linear:NA,NB[,DELAY] or hw:NA,NB,PIN,POUT[,DELAY]");
   m->excludes(f);
@@ -65,25 +41,9 @@ void AddDiagnoseCommand(CLI::App& app) {
     if (o->model.empty() == o->fit.empty()) throw InputError("diagnose needs exactly one of --model FILE or --fit SPEC");
     std::string err;
     if (!o->o.IsValid(&err)) throw InputError("diagnose: " + err);
-    if (!o->effects.empty()) {
-      std::size_t pos = 0;
-      while (pos <= o->effects.size()) {
-        const auto comma = o->effects.find(',', pos);
-        const std::string tok = o->effects.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-        const auto at = tok.find('@');
-        if (at == std::string::npos) throw InputError(fmt::format("--effects: '{}' must be EFFECT@LOCATION, e.g. backlash@input", tok));
-        const auto e = diagnose::ParseEffect(tok.substr(0, at));
-        const auto l = diagnose::ParseLocation(tok.substr(at + 1));
-        bool known = false;
-        for (const auto& c : diagnose::CandidateEffects()) known = known || (c.first == e && c.second == l);
-        if (!known) throw InputError(fmt::format("--effects: '{}' is not a defined effect block (see docs/diagnose.md)", tok));
-        o->o.candidates.emplace_back(e, l);
-        if (comma == std::string::npos) break;
-        pos = comma + 1;
-      }
-    }
-    const auto ident = LoadRecording(o->data, o->u_col, o->y_col, o->t_col);
-    const auto valid = LoadRecording(o->validate, o->u_col, o->y_col, o->t_col);
+    if (!o->effects.empty()) o->o.candidates = diagnose::ParseCandidates(o->effects);
+    const auto ident = diagnose::LoadRecording(o->data, o->u_col, o->y_col, o->t_col);
+    const auto valid = diagnose::LoadRecording(o->validate, o->u_col, o->y_col, o->t_col);
     HwModel nominal;
     if (!o->model.empty()) {
       nominal = HwModel::load(o->model);

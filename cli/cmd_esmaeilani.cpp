@@ -9,6 +9,7 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "core/hw_model.hpp"
+#include "core/recording.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 
 namespace hw::cli {
@@ -26,7 +27,8 @@ void AddEsmaeilaniCommand(CLI::App& app) {
     bool no_clamp = false, refine_oe = false, oe_estimate_x0 = false;
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("--data", o->data, "CSV segments used for estimation (columns u,y; one segment per file)")
+  cmd->add_option("--data", o->data,
+                  "segments used for estimation (CSV with columns u,y, or FILE.mat:u=VAR,y=VAR; one segment per file)")
       ->required()
       ->expected(1, -1);
   cmd->add_option("--order", o->order, "order n of the linear block (observable canonical form)");
@@ -54,7 +56,7 @@ void AddEsmaeilaniCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "model JSON to write");
   cmd->callback([o] {
     auto load = [&](const std::string& path) {
-      const CsvTable t = read_csv(path);
+      const CsvTable t = read_recording(path, {o->u_col, o->y_col});
       esmaeilani::Segment s;
       s.u = t.column(o->u_col);
       s.y = t.column(o->y_col);
@@ -98,13 +100,8 @@ void AddEsmaeilaniCommand(CLI::App& app) {
     fmt::print("g^-1 pairs (y', g'):\n");
     for (std::size_t k = 0; k < m.y_grid.size(); ++k)
       fmt::print("  {:12.6g} {:12.6g}\n", m.y_grid[k], m.ginv_values[k]);
-    HwModel model = m.ToHwModel(opt.clamp_output);
-    nlohmann::json j = model.to_json();
-    j["esmaeilani"] = m.ToJson();
-    j["esmaeilani"]["constraints"] = cons.ToJson();
-    j["esmaeilani"]["final_cost"] = sum.final_cost;
-    if (sum.output_error.ran) j["esmaeilani"]["output_error_cost"] = sum.output_error.final_cost;
-    write_text_atomic(o->out, j.dump(2) + "\n");
+    const HwModel model = m.ToHwModel(opt.clamp_output);
+    write_text_atomic(o->out, esmaeilani::ModelFileJson(m, opt, cons, sum).dump(2) + "\n");
     fmt::print("project model: a = [{:.6g}], b = [{:.6g}], delay {}; wrote {}\n", fmt::join(model.linear.a, ", "),
                fmt::join(model.linear.b, ", "), model.linear.delay, o->out);
     for (const auto& p : o->validate) {

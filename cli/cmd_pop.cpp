@@ -26,8 +26,7 @@ void AddPopCommand(CLI::App& app) {
     const auto problem = relax::LoadPolyProblem(o->problem);
     relax::RelaxationOptions options;
     options.order = o->order;
-    if (o->order > 0 && o->order < problem.minimal_order())
-      throw InputError(fmt::format("--order {} is below this problem's minimal order {}", o->order, problem.minimal_order()));
+    relax::CheckRelaxationOrder(problem, o->order);
     if (!o->export_path.empty()) {
       const relax::MomentRelaxation relaxation(problem, o->order > 0 ? o->order : problem.minimal_order());
       sdp::WriteSdpaSparse(o->export_path, relaxation.lmi());
@@ -36,16 +35,7 @@ void AddPopCommand(CLI::App& app) {
     const auto r = relax::SolveRelaxation(options, problem, *solver);
     const auto names = problem.names.empty() ? default_variable_names(problem.num_vars) : problem.names;
     if (o->json) {
-      nlohmann::json j = {{"status", relax::ToString(r.status)}, {"message", r.message}, {"order", r.order},
-                          {"solver", o->solver}, {"sdp_status", sdp::ToString(r.sdp.status)},
-                          {"moments", r.num_moments}, {"blocks", r.num_blocks}, {"flat", r.flat},
-                          {"sense", problem.maximize ? "max" : "min"}};
-      if (r.status == relax::RelaxationStatus::kSolved) {
-        j["bound"] = r.bound;
-        j["first_moments"] = r.first_moments;
-        j["minimizers"] = r.minimizers;
-        j["rank"] = r.rank;
-      }
+      nlohmann::json j = relax::RelaxationJson(problem, r, o->solver);
       if (!o->export_path.empty()) j["exported"] = o->export_path;
       fmt::print("{}\n", j.dump(2));
     } else {

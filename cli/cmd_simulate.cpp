@@ -7,6 +7,7 @@
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
 #include "core/hw_model.hpp"
+#include "core/recording.hpp"
 
 namespace hw::cli {
 
@@ -22,7 +23,7 @@ void AddSimulateCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--model", o->model, "model JSON (see README: Model JSON)");
-  cmd->add_option("--input", o->input, "CSV with the input column");
+  cmd->add_option("--input", o->input, "recording with the input column (CSV, or FILE.mat:u=VAR)");
   cmd->add_option("--example", o->example,
                   "built-in example instead of --model/--input: cerone2011 (paper 001, Section VI)")
       ->check(CLI::IsMember({"cerone2011"}));
@@ -52,7 +53,7 @@ void AddSimulateCommand(CLI::App& app) {
     if (o->model.empty() || o->input.empty())
       throw InputError("simulate needs --model and --input, or --example NAME");
     const HwModel model = HwModel::load(o->model);
-    const CsvTable in = read_csv(o->input);
+    const CsvTable in = read_recording(o->input, {o->u_col});
     const auto& u = in.column(o->u_col);
     const auto w = model.simulate(u);
     std::mt19937_64 rng(o->seed);

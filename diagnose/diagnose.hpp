@@ -37,6 +37,14 @@ struct Recording {
   std::vector<double> t, u, y;
 };
 
+// A recording from its signals, checked for diagnosis: u, y (and t unless empty: then t is the sample index)
+// equally long, t strictly increasing, at least 60 samples. Throws InputError naming `name` and `t_col`.
+Recording MakeRecording(std::string name, std::vector<double> t, std::vector<double> u, std::vector<double> y,
+                        const std::string& t_col = "t");
+// The recording named by a spec (core/recording.hpp: CSV or FILE.mat:u=..,y=..[,t=..]); t_col is optional.
+Recording LoadRecording(const std::string& spec, const std::string& u_col, const std::string& y_col,
+                        const std::string& t_col);
+
 struct DiagnoseOptions {
   double noise_std = 0.0;             // 0 = estimate from the nominal residual
   std::size_t init_samples = 0;       // leading samples excluded from every cost (transient from rest)

@@ -100,6 +100,25 @@ std::vector<std::pair<Effect, Location>> CandidateEffects() {
           {E::kStateSaturation, L::kState}};
 }
 
+std::vector<std::pair<Effect, Location>> ParseCandidates(const std::string& list) {
+  std::vector<std::pair<Effect, Location>> out;
+  std::size_t pos = 0;
+  while (pos <= list.size()) {
+    const auto comma = std::min(list.find(',', pos), list.size());
+    const std::string tok = list.substr(pos, comma - pos);
+    const auto at = tok.find('@');
+    if (at == std::string::npos)
+      throw InputError(fmt::format("effects: '{}' must be EFFECT@LOCATION, e.g. backlash@input", tok));
+    const std::pair<Effect, Location> block{ParseEffect(tok.substr(0, at)), ParseLocation(tok.substr(at + 1))};
+    const auto all = CandidateEffects();
+    if (std::find(all.begin(), all.end(), block) == all.end())
+      throw InputError(fmt::format("effects: '{}' is not a defined effect block (see docs/diagnose.md)", tok));
+    out.push_back(block);
+    pos = comma + 1;
+  }
+  return out;
+}
+
 bool EffectBlock::IsValid(std::string* error) const {
   auto fail = [&](std::string m) {
     if (error) *error = std::move(m);

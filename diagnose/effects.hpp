@@ -64,6 +64,8 @@ struct EffectBlock {
 
 // The candidate set the diagnosis tries: every (effect, location) pair that is defined.
 std::vector<std::pair<Effect, Location>> CandidateEffects();
+// "backlash@input,deadzone@output": a subset of CandidateEffects(); throws InputError on an unknown block.
+std::vector<std::pair<Effect, Location>> ParseCandidates(const std::string& list);
 
 // Nominal HW model + one effect block.
 struct AugmentedModel {

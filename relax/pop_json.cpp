@@ -84,4 +84,23 @@ PolyProblem LoadPolyProblem(const std::string& path) {
   return ParsePolyProblem(j, path);
 }
 
+void CheckRelaxationOrder(const PolyProblem& problem, int order) {
+  if (order > 0 && order < problem.minimal_order())
+    throw InputError(fmt::format("order {} is below this problem's minimal order {}", order, problem.minimal_order()));
+}
+
+nlohmann::json RelaxationJson(const PolyProblem& problem, const RelaxationResult& r, const std::string& solver) {
+  nlohmann::json j = {{"status", ToString(r.status)}, {"message", r.message}, {"order", r.order},
+                      {"solver", solver}, {"sdp_status", sdp::ToString(r.sdp.status)},
+                      {"moments", r.num_moments}, {"blocks", r.num_blocks}, {"flat", r.flat},
+                      {"sense", problem.maximize ? "max" : "min"}};
+  if (r.status == RelaxationStatus::kSolved) {
+    j["bound"] = r.bound;
+    j["first_moments"] = r.first_moments;
+    j["minimizers"] = r.minimizers;
+    j["rank"] = r.rank;
+  }
+  return j;
+}
+
 }  // namespace hw::relax

@@ -18,4 +18,10 @@ namespace hw::relax {
 PolyProblem ParsePolyProblem(const nlohmann::json& j, const std::string& source);
 PolyProblem LoadPolyProblem(const std::string& path);
 
+// Throws InputError when `order` (0 = minimal) is below the problem's minimal order.
+void CheckRelaxationOrder(const PolyProblem& problem, int order);
+// The outcome as `hwbounds pop --json` prints it (and the Python module returns): status, message, order, solver,
+// sdp_status, moments, blocks, flat, sense, and when solved bound, first_moments, minimizers, rank.
+nlohmann::json RelaxationJson(const PolyProblem& problem, const RelaxationResult& r, const std::string& solver);
+
 }  // namespace hw::relax

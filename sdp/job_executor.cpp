@@ -1,6 +1,7 @@
 #include "sdp/job_executor.hpp"
 
 #include <poll.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -91,6 +92,7 @@ std::vector<JobResult> InProcessExecutor::Map(const std::vector<std::string>& sp
                                               const JobDone& on_done) {
   std::vector<JobResult> out(specs.size());
   for (std::size_t i = 0; i < specs.size(); ++i) {
+    if (interrupt_check_) interrupt_check_();
     out[i] = RunJobGuarded(fn, specs[i]);
     if (on_done) on_done(i, out[i]);
   }
@@ -104,6 +106,18 @@ std::vector<JobResult> ForkExecutor::Map(const std::vector<std::string>& specs, 
                                          const JobDone& on_done) {
   std::vector<JobResult> out(specs.size());
   std::map<int, Child> running;  // by read fd
+  // Map left by an exception (on_done, the interrupt check, fork failure): kill and reap every worker.
+  struct KillOnUnwind {
+    std::map<int, Child>& running;
+    ~KillOnUnwind() {
+      for (auto& [fd, c] : running) {
+        ::kill(c.pid, SIGKILL);
+        ::close(fd);
+        while (::waitpid(c.pid, nullptr, 0) < 0 && errno == EINTR) {
+        }
+      }
+    }
+  } kill_on_unwind{running};
   std::size_t next = 0;
   std::fflush(nullptr);  // buffered output must not be duplicated into the children
   auto launch = [&](std::size_t i) {
@@ -126,7 +140,9 @@ std::vector<JobResult> ForkExecutor::Map(const std::vector<std::string>& specs, 
     while (next < specs.size() && static_cast<int>(running.size()) < workers_) launch(next++);
     std::vector<pollfd> polls;
     for (const auto& [fd, c] : running) polls.push_back({fd, POLLIN, 0});
-    if (::poll(polls.data(), polls.size(), -1) < 0) {
+    const int ready = ::poll(polls.data(), polls.size(), interrupt_check_ ? 100 : -1);
+    if (interrupt_check_) interrupt_check_();
+    if (ready < 0) {
       if (errno == EINTR) continue;
       throw std::runtime_error(fmt::format("poll: {}", std::strerror(errno)));
     }
@@ -145,9 +161,10 @@ std::vector<JobResult> ForkExecutor::Map(const std::vector<std::string>& specs, 
       int status = 0;
       while (::waitpid(c.pid, &status, 0) < 0 && errno == EINTR) {
       }
-      out[c.index] = Decode(c, status);
-      if (on_done) on_done(c.index, out[c.index]);
-      running.erase(p.fd);
+      const std::size_t index = c.index;
+      out[index] = Decode(c, status);
+      running.erase(p.fd);  // before on_done: a reaped worker must not be killed again if on_done throws
+      if (on_done) on_done(index, out[index]);
     }
   }
   return out;

@@ -6,7 +6,8 @@
 //   - ForkExecutor:      forked local worker processes, one per job, `workers` at a time;
 //   - MpiExecutor:       MPI ranks (sdp/mpi_executor.hpp), rank 0 coordinating, for one or many machines.
 // A job that crashes its process (CSDP calls exit() on some errors) comes back as a failed JobResult with the
-// reason; it never takes the run down and is never silently lost.
+// reason; it never takes the run down and is never silently lost. When Map itself ends by an exception (from
+// on_done or the interrupt check), no worker process is left behind.
 #include <functional>
 #include <memory>
 #include <string>
@@ -44,6 +45,13 @@ class JobExecutor {
   virtual void Serve(const JobFunction& fn) { (void)fn; }
   // Coordinator side: releases the workers' Serve() (one session = one engine run).
   virtual void EndSession() {}
+  // Called on the coordinating side while Map runs: before each job in process, and at least every 100 ms
+  // while waiting for forked workers. An exception it throws ends Map (forked workers still running are
+  // killed and reaped first) and propagates: an embedding host stops a run this way (Python's Ctrl-C).
+  void set_interrupt_check(std::function<void()> check) { interrupt_check_ = std::move(check); }
+
+ protected:
+  std::function<void()> interrupt_check_;
 };
 
 class InProcessExecutor : public JobExecutor {

@@ -3,6 +3,10 @@
 // set-membership engine gives the same intervals as the local run.
 #include <sys/wait.h>
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -59,6 +63,54 @@ TEST(ForkExecutor, CrashesAndExceptionsBecomeFailedResults) {
   EXPECT_EQ(out[3].error, "bad spec");
   EXPECT_TRUE(out[4].ok);
   EXPECT_EQ(out[4].text.size(), std::size_t{1} << 20);
+}
+
+// True when this process has no child process left (every worker was reaped).
+bool NoChildrenLeft() { return ::waitpid(-1, nullptr, WNOHANG) < 0 && errno == ECHILD; }
+
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A host's interrupt (Python's Ctrl-C) ends Map promptly even while every worker is busy, and leaves no
+// worker process behind.
+TEST(ForkExecutor, InterruptCheckStopsTheRunAndKillsItsWorkers) {
+  ForkExecutor exec(2);
+  int checks = 0;
+  exec.set_interrupt_check([&] {
+    if (++checks == 3) throw std::runtime_error("interrupted");
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_THROW(exec.Map({"a", "b", "c"}, [](const std::string&) -> std::string {
+    ::sleep(60);
+    return "late";
+  }), std::runtime_error);
+  EXPECT_LT(SecondsSince(t0), 10.0);
+  EXPECT_TRUE(NoChildrenLeft());
+}
+
+TEST(ForkExecutor, ExceptionFromOnDoneLeavesNoWorkerBehind) {
+  ForkExecutor exec(3);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_THROW(exec.Map({"fast", "slow", "slow"},
+                        [](const std::string& s) -> std::string {
+                          if (s == "slow") ::sleep(60);
+                          return s;
+                        },
+                        [](std::size_t, const JobResult&) { throw std::runtime_error("stop"); }),
+               std::runtime_error);
+  EXPECT_LT(SecondsSince(t0), 10.0);
+  EXPECT_TRUE(NoChildrenLeft());
+}
+
+TEST(InProcessExecutor, InterruptCheckRunsBeforeEachJob) {
+  InProcessExecutor exec;
+  int ran = 0;
+  exec.set_interrupt_check([&] {
+    if (ran == 2) throw std::runtime_error("interrupted");
+  });
+  EXPECT_THROW(exec.Map({"a", "b", "c"}, [&](const std::string& s) { ++ran; return s; }), std::runtime_error);
+  EXPECT_EQ(ran, 2);
 }
 
 TEST(InProcessExecutor, SameAnswersAsFork) {

@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
+#include "core/recording.hpp"
 
 namespace hw::brouri {
 
@@ -230,22 +231,37 @@ FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const Frequ
   return pt;
 }
 
-Recording ReadRecording(const std::string& path, double sample_time, const std::string& y_col) {
-  const CsvTable t = read_csv(path);
+Recording CheckRecording(const CsvTable& t, double sample_time, const std::string& y_col) {
   Recording r;
-  if (!t.has(y_col))
-    throw InputError(fmt::format("{}: no column '{}' (the measured output); columns are {}", path, y_col,
-                                 fmt::join(t.names, ", ")));
   r.y = t.column(y_col);
   if (t.has("u")) r.u = t.column("u");
   if (t.has("t") && t.rows() >= 2) {
     const auto& tt = t.column("t");
     for (std::size_t i = 1; i < tt.size(); ++i)
       if (std::abs(tt[i] - tt[i - 1] - sample_time) > 1e-6 * sample_time + 1e-9)
-        throw InputError(fmt::format("{}: row {}: time step {} differs from the planned sample time {}", path, i + 1,
-                                     tt[i] - tt[i - 1], sample_time));
+        throw InputError(fmt::format("{}: row {}: time step {} differs from the planned sample time {}", t.source,
+                                     i + 1, tt[i] - tt[i - 1], sample_time));
   }
   return r;
+}
+
+Recording ReadRecording(const std::string& path, double sample_time, const std::string& y_col) {
+  return CheckRecording(read_recording(path, {y_col}, {"u", "t"}), sample_time, y_col);
+}
+
+nlohmann::json StepsResultJson(const NonlinearEstimate& estimate, const Summary& summary) {
+  nlohmann::json result = estimate.to_json();
+  result["stage"] = "steps";
+  result["summary"] = summary.message;
+  return result;
+}
+
+nlohmann::json SinesResultJson(const SinePlan& plan, const std::vector<FrequencyPoint>& points) {
+  nlohmann::json result = {{"stage", "sines"}, {"points", nlohmann::json::array()}};
+  for (const auto& p : points) result["points"].push_back(ToJson(p));
+  result["nonlinear"] = plan.nonlinear.to_json();
+  result["note"] = "normalised model (eq. 4): G(0) = 1, phi = -arg G";
+  return result;
 }
 
 }  // namespace hw::brouri

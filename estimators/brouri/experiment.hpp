@@ -6,13 +6,14 @@
 //   Stage 2 ("sines"): per frequency, z = U sin(omega t) sampled with an integer number of samples per
 //     period; the input to apply is u = precompensator(z) built from the stage-1 estimate. The first
 //     `transient_periods` periods (>= the settling time) are discarded, the next N averaged (eq. 23).
-// Recordings are CSV files with columns u (as applied) and y (measured); a t column, when present, is
-// checked against the planned sample time.
+// Recordings are CSV (or .mat, core/recording.hpp) files with columns u (as applied) and y (measured); a t
+// column, when present, is checked against the planned sample time.
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "core/csv_table.hpp"
 #include "estimators/brouri/frequency_stage.hpp"
 #include "estimators/brouri/nonlinear_stage.hpp"
 
@@ -66,10 +67,17 @@ NonlinearEstimate EstimateFromSteps(const StepPlan& plan, const NonlinearOptions
 FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const FrequencyOptions& options,
                                 const std::vector<double>& u, const std::vector<double>& y, Summary* summary);
 
-// Reads a recording CSV (columns u and y_col, optional t) and checks it against the planned input.
+// Reads a recording (core/recording.hpp: a CSV, or FILE.mat:y=VAR[,u=VAR,t=VAR]; column y_col, optional u and t)
+// and checks its time column against the planned sample time.
 struct Recording {
   std::vector<double> u, y;
 };
 Recording ReadRecording(const std::string& path, double sample_time, const std::string& y_col);
+// The same checks on a recording already read (columns y_col, optional u and t; messages name t.source).
+Recording CheckRecording(const CsvTable& t, double sample_time, const std::string& y_col);
+
+// The result JSON `hwbounds brouri estimate` writes for each stage (points unwrapped by the caller).
+nlohmann::json StepsResultJson(const NonlinearEstimate& estimate, const Summary& summary);
+nlohmann::json SinesResultJson(const SinePlan& plan, const std::vector<FrequencyPoint>& points);
 
 }  // namespace hw::brouri

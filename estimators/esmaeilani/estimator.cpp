@@ -471,6 +471,16 @@ nlohmann::json EsmaeilaniModel::ToJson() const {
           {"initial_states", initial_states}};
 }
 
+nlohmann::json ModelFileJson(const EsmaeilaniModel& m, const Options& options, const Constraints& constraints,
+                             const Summary& summary) {
+  nlohmann::json j = m.ToHwModel(options.clamp_output).to_json();
+  j["esmaeilani"] = m.ToJson();
+  j["esmaeilani"]["constraints"] = constraints.ToJson();
+  j["esmaeilani"]["final_cost"] = summary.final_cost;
+  if (summary.output_error.ran) j["esmaeilani"]["output_error_cost"] = summary.output_error.final_cost;
+  return j;
+}
+
 // ---------------------------------------------------------------------------------------------
 EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& segments,
                          const Constraints& constraints, Summary* summary) {

@@ -169,6 +169,11 @@ struct Summary {
   bool ok() const { return status != Status::kFailed; }
 };
 
+// The model file `hwbounds esmaeilani` writes: the project model (README: Model JSON) of the estimate, with
+// the paper's parametrisation, the known information and the final costs under "esmaeilani".
+nlohmann::json ModelFileJson(const EsmaeilaniModel& m, const Options& options, const Constraints& constraints,
+                             const Summary& summary);
+
 // Throws InputError for unusable input: bad options, too few data for the unknowns, contradictory
 // constraints (reported by the first QP as infeasible).
 EsmaeilaniModel Estimate(const Options& options, const std::vector<Segment>& segments,

@@ -1,0 +1,177 @@
+// hwbounds.bounds: guaranteed parameter intervals (relax::ComputeBounds over relax::HwOuterSet), the same
+// engine and options as `hwbounds bounds`, with a progress callback and Ctrl-C.
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "python/py_convert.hpp"
+#include "python/py_module.hpp"
+#include "relax/set_membership.hpp"
+
+namespace hw::python {
+namespace {
+
+// The prior box: None (every parameter in [-10, 10], as the CLI), (lo, hi) for every parameter, a dict
+// {name: (lo, hi)} over that default, or one (lo, hi) per parameter.
+std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::vector<std::string>& names) {
+  std::vector<std::pair<double, double>> box(names.size(), {-10.0, 10.0});
+  auto pair = [](py::handle p, const std::string& what) {
+    const auto v = ToVector(p, what);
+    if (v.size() != 2 || !(v[0] < v[1])) throw py::value_error(fmt::format("{}: expected (LO, HI) with LO < HI", what));
+    return std::pair<double, double>{v[0], v[1]};
+  };
+  if (h.is_none()) return box;
+  if (py::isinstance<py::dict>(h)) {
+    for (const auto& [k, v] : h.cast<py::dict>()) {
+      const std::string name = py::str(k);
+      const auto at = std::find(names.begin(), names.end(), name);
+      if (at == names.end())
+        throw py::value_error(
+            fmt::format("box: no parameter '{}'; the parameters are: {}", name, fmt::join(names, ", ")));
+      box[at - names.begin()] = pair(v, "box['" + name + "']");
+    }
+    return box;
+  }
+  if (!py::isinstance<py::sequence>(h) || py::isinstance<py::str>(h))
+    throw py::type_error("box: expected None, (lo, hi), {name: (lo, hi)} or one (lo, hi) per parameter");
+  const auto seq = h.cast<py::sequence>();
+  if (seq.size() == 2 && !py::isinstance<py::sequence>(seq[0])) {
+    box.assign(names.size(), pair(h, "box"));
+    return box;
+  }
+  if (seq.size() != names.size())
+    throw py::value_error(
+        fmt::format("box: {} pairs for {} parameters ({})", seq.size(), names.size(), fmt::join(names, ", ")));
+  for (std::size_t i = 0; i < names.size(); ++i) box[i] = pair(seq[i], "box['" + names[i] + "']");
+  return box;
+}
+
+std::vector<double> NoiseBound(py::handle h, std::size_t n) {
+  if (py::isinstance<py::float_>(h) || py::isinstance<py::int_>(h)) {
+    const double b = h.cast<double>();
+    if (!(b > 0) || !std::isfinite(b))
+      throw py::value_error(fmt::format("noise_bound must be a positive number (got {}), or one bound per sample", b));
+    return std::vector<double>(n, b);
+  }
+  return ToVector(h, "noise_bound");
+}
+
+py::dict ProgressDict(const relax::BoundsProgress& p) {
+  py::dict d;
+  d["phase"] = p.phase;
+  d["done"] = p.done;
+  d["total"] = p.total;
+  d["elapsed_seconds"] = p.elapsed_seconds;
+  d["eta_seconds"] = p.eta_seconds;
+  return d;
+}
+
+struct BoundsArgs {
+  relax::HwStructure structure;
+  std::string input_basis, output_basis, executor;
+  int horizon = 2;
+  relax::BoundsOptions options;
+};
+
+py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::object progress,
+                  const std::string& source) {
+  relax::HwData data;
+  data.source = source;
+  data.u = ToVector(u, "u");
+  data.y = ToVector(y, "y");
+  data.noise_bound = NoiseBound(noise_bound, data.y.size());
+  a.structure.input_basis = relax::parse_basis(a.input_basis);
+  a.structure.output_basis = relax::parse_basis(a.output_basis);
+  RequireValid(a.structure);
+  RequireValid(data);
+  if (a.executor == "mpi")
+    throw py::value_error(
+        "executor 'mpi' runs under mpirun from the CLI (`hwbounds bounds --executor mpi`); use "
+        "'fork' or 'inprocess' from Python");
+  a.options.executor = sdp::MakeExecutor(a.executor, a.options.threads);
+  RequireValid(a.options, "bounds options: ");
+  const auto names = relax::MakeLayout(a.structure).names;
+  const relax::HwOuterSet set(a.structure, data, a.horizon, BoxFromPython(box, names));
+  // Ctrl-C is checked while the engine waits for its jobs and at every progress report.
+  a.options.executor->set_interrupt_check(CheckPythonSignals);
+  auto report = [&progress](const relax::BoundsProgress& p) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!progress.is_none()) progress(ProgressDict(p));
+  };
+  const auto summary = WithoutGil([&] { return relax::ComputeBounds(a.options, set, report); });
+  nlohmann::json j = summary.to_json();
+  j["data"] = source;
+  j["structure"] = {{"na", a.structure.na},
+                    {"nb", a.structure.nb},
+                    {"proper", !a.structure.strictly_proper},
+                    {"input_basis", a.input_basis},
+                    {"output_basis", a.output_basis}};
+  return ToPython(j);
+}
+
+}  // namespace
+
+void DefineBounds(py::module_& m) {
+  const relax::HwStructure s;
+  const relax::BoundsOptions o;
+  const relax::ConstraintGenerationOptions& g = o.generation;
+  m.def(
+      "bounds",
+      [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
+         std::string output_basis, int horizon, int order, bool strictly_proper, py::handle box, std::string solver,
+         int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
+         bool lp_screen, bool retry_with_other_solver, int contraction_passes, double contraction_min_shrink,
+         int contraction_max_rounds, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
+         py::object progress, std::string source) {
+        BoundsArgs a;
+        a.structure.na = na;
+        a.structure.nb = nb;
+        a.structure.strictly_proper = strictly_proper;
+        a.input_basis = std::move(input_basis);
+        a.output_basis = std::move(output_basis);
+        a.horizon = horizon;
+        a.executor = std::move(executor);
+        auto& op = a.options;
+        op.order = order;
+        op.solver = std::move(solver);
+        op.threads = threads;
+        op.run_dir = std::move(run_dir);
+        op.parameters = std::move(parameters);
+        op.cheap_pass = cheap_pass;
+        op.lp_screen = lp_screen;
+        op.retry_with_other_solver = retry_with_other_solver;
+        op.contraction_passes = contraction_passes;
+        op.contraction_min_shrink = contraction_min_shrink;
+        op.contraction_max_rounds = contraction_max_rounds;
+        op.generation.max_rounds = max_rounds;
+        op.generation.add_per_round = add_per_round;
+        op.generation.violation_tolerance = violation_tolerance;
+        op.generation.verify.enabled = verify;
+        return Bounds(u, y, noise_bound, std::move(a), box, std::move(progress), source);
+      },
+      R"doc(Guaranteed parameter intervals of a Hammerstein-Wiener model from a recording (paper 001), as
+`hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
+Options mirror relax::HwStructure and relax::BoundsOptions (same names, defaults and validation messages).
+box: None (every parameter in [-10, 10]), (lo, hi), {name: (lo, hi)} or one pair per parameter.
+progress: called as progress(dict(phase, done, total, elapsed_seconds, eta_seconds)) after each job.
+Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
+counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
+its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
+      py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
+      py::arg("input_basis") = "poly:3", py::arg("output_basis") = "poly:3", py::arg("horizon") = 2,
+      py::arg("order") = o.order, py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
+      py::arg("box") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
+      py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
+      py::arg("cheap_pass") = o.cheap_pass, py::arg("lp_screen") = o.lp_screen,
+      py::arg("retry_with_other_solver") = o.retry_with_other_solver,
+      py::arg("contraction_passes") = o.contraction_passes,
+      py::arg("contraction_min_shrink") = o.contraction_min_shrink,
+      py::arg("contraction_max_rounds") = o.contraction_max_rounds, py::arg("max_rounds") = g.max_rounds,
+      py::arg("add_per_round") = g.add_per_round, py::arg("violation_tolerance") = g.violation_tolerance,
+      py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data");
+}
+
+}  // namespace hw::python

@@ -1,0 +1,68 @@
+// hwbounds.read_recording, hwbounds.simulate, hwbounds.pop.
+#include "core/hw_model.hpp"
+#include "core/recording.hpp"
+#include "python/py_convert.hpp"
+#include "python/py_module.hpp"
+#include "relax/pop_json.hpp"
+#include "sdp/sdp_solver.hpp"
+
+namespace hw::python {
+
+void DefineRecordings(py::module_& m) {
+  m.def(
+      "read_recording",
+      [](const std::string& spec, const std::vector<std::string>& required, const std::vector<std::string>& optional) {
+        const CsvTable t = read_recording(spec, required, optional);
+        py::dict out;  // the columns asked for, as from a .mat file (a CSV may hold more)
+        for (const auto* names : {&required, &optional})
+          for (const auto& name : *names)
+            if (t.has(name)) out[py::str(name)] = ToArray(t.column(name));
+        return out;
+      },
+      R"doc(Reads a recording as every command does: "rec.csv", "rec.mat:u=vir,y=qm[,t=time]" (MATLAB v4, v5,
+v7.3), "rec.mat" (variables named as the columns) or "rec.csv:u=V1,y=V2". required columns must be there,
+optional ones may be. Returns {column: numpy array} for those columns. Bad input raises ValueError with
+the CLI's message.)doc",
+      py::arg("spec"), py::arg("required") = std::vector<std::string>{"u", "y"},
+      py::arg("optional") = std::vector<std::string>{"t"});
+}
+
+void DefineModels(py::module_& m) {
+  m.def(
+      "simulate",
+      [](py::handle model, py::handle u) {
+        const HwModel hw = py::isinstance<py::str>(model) ? HwModel::load(model.cast<std::string>())
+                                                          : HwModel::from_json(ToJson(model));
+        const auto input = ToVector(u, "u");
+        return ToArray(WithoutGil([&] { return hw.simulate(input); }));
+      },
+      R"doc(Noise-free output w of a model (a dict in the README's Model JSON format, or the path of such a
+file) driven by the input u, simulated from rest as `hwbounds simulate` does. Returns a numpy array.)doc",
+      py::arg("model"), py::arg("u"));
+
+  const relax::RelaxationOptions r;
+  m.def(
+      "pop",
+      [](py::handle problem, int order, const std::string& solver, double rank_tolerance, double extraction_tolerance) {
+        const relax::PolyProblem p = py::isinstance<py::str>(problem)
+                                         ? relax::LoadPolyProblem(problem.cast<std::string>())
+                                         : relax::ParsePolyProblem(ToJson(problem), "problem");
+        relax::RelaxationOptions options;
+        options.order = order;
+        options.rank_tolerance = rank_tolerance;
+        options.extraction_tolerance = extraction_tolerance;
+        RequireValid(options);
+        relax::CheckRelaxationOrder(p, order);
+        auto backend = sdp::MakeSolver(solver);
+        const auto result = WithoutGil([&] { return relax::SolveRelaxation(options, p, *backend); });
+        return ToPython(relax::RelaxationJson(p, result, solver));
+      },
+      R"doc(One moment (Lasserre) relaxation of a polynomial optimisation problem, as `hwbounds pop --json`.
+problem: a dict {"variables": [...], "minimize" | "maximize": "...", "constraints": [...], "box": {...}} or the
+path of such a JSON file; order 0 = minimal. Returns the CLI's JSON as a dict (status, bound when solved,
+flat, minimizers, ...).)doc",
+      py::arg("problem"), py::arg("order") = r.order, py::arg("solver") = "sdpa", py::kw_only(),
+      py::arg("rank_tolerance") = r.rank_tolerance, py::arg("extraction_tolerance") = r.extraction_tolerance);
+}
+
+}  // namespace hw::python

@@ -1,0 +1,133 @@
+"""hwbounds.bounds: the same intervals as `hwbounds bounds --json` on the same inputs, the same validation
+messages, progress reports, and a run stopped by Ctrl-C or by an exception leaves no worker process."""
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import scipy.io
+
+import hwbounds
+from conftest import CERONE_N300, cli_error, load_json, run_cli, without
+
+SAMPLES = 60  # a prefix of the bundled recording: a few seconds per run at horizon 1, order 1
+
+
+@pytest.fixture
+def recording(tmp_path):
+    data = np.loadtxt(CERONE_N300, delimiter=",", skiprows=1)[:SAMPLES]
+    path = tmp_path / "rec.csv"
+    with open(path, "w") as f:
+        f.write("t,u,w,y,noise_bound\n")
+        for row in data:
+            f.write(",".join(repr(float(v)) for v in row) + "\n")
+    return str(path), {"u": data[:, 1], "y": data[:, 3], "noise_bound": data[:, 4]}
+
+
+def test_same_result_as_the_cli(recording, tmp_path):
+    path, rec = recording
+    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--params", "a1,b1",
+            "--solver", "csdp", "--threads", 2, "--quiet", "--json", tmp_path / "cli.json")
+    cli = load_json(tmp_path / "cli.json")
+    py = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, parameters=["a1", "b1"],
+                         solver="csdp", threads=2, source=path)
+    assert [iv["parameter"] for iv in py["intervals"]] == ["a1", "b1"]
+    assert py["intervals"][0]["lower"]["status"] == "guaranteed"
+    assert py["intervals"][0]["lower"]["value"] < py["intervals"][0]["upper"]["value"]
+    assert without(py, "timing") == without(cli, "timing")
+
+
+def test_cli_bounds_from_a_mat_file_equal_those_from_the_csv(recording, tmp_path):
+    path, rec = recording
+    mat = tmp_path / "rec.mat"
+    scipy.io.savemat(mat, {"vir": rec["u"], "qm": rec["y"].reshape(-1, 1), "dy": rec["noise_bound"]})
+    common = ("--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--params", "a1", "--solver", "csdp",
+              "--threads", 2, "--quiet")
+    run_cli("bounds", "--data", path, *common, "--json", tmp_path / "csv.json")
+    run_cli("bounds", "--data", f"{mat}:u=vir,y=qm,noise_bound=dy", *common, "--json", tmp_path / "mat.json")
+    assert without(load_json(tmp_path / "mat.json"), "timing", "data") == \
+        without(load_json(tmp_path / "csv.json"), "timing", "data")
+
+
+def test_validation_errors_carry_the_cli_message(recording):
+    path, rec = recording
+    args = ("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--quiet")
+    with pytest.raises(ValueError) as e:
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, threads=-1)
+    assert str(e.value) == "bounds options: threads must be >= 0" == cli_error(*args, "--threads", -1)
+    with pytest.raises(ValueError) as e:
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], na=0, horizon=1, order=1)
+    assert str(e.value) == "na must be >= 1" == cli_error(*args, "--na", 0)
+    with pytest.raises(ValueError) as e:
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, solver="mosek")
+    assert str(e.value) == "bounds options: solver 'mosek' unknown; expected csdp or sdpa"
+    with pytest.raises(ValueError, match=r"^bounds options: order must be >= 1$"):
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=0)
+    with pytest.raises(ValueError, match=r"^noise_bound must be a positive number \(got 0\), or one bound per sample$"):
+        hwbounds.bounds(rec["u"], rec["y"], 0.0, horizon=1, order=1)
+    with pytest.raises(ValueError, match=r"^data: u has 60 samples but y has 59$"):
+        hwbounds.bounds(rec["u"], rec["y"][:-1], 0.1, horizon=1, order=1)
+    with pytest.raises(ValueError, match=r"^box: no parameter 'a9'; the parameters are: gamma2, gamma3, alpha2"):
+        hwbounds.bounds(rec["u"], rec["y"], 0.1, horizon=1, order=1, box={"a9": (0, 1)})
+
+
+def test_progress_reports_every_job(recording):
+    _, rec = recording
+    seen = []
+    result = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, parameters=["a1"],
+                             solver="csdp", threads=2, progress=seen.append, box=(-5, 5))
+    assert seen and set(seen[0]) == {"phase", "done", "total", "elapsed_seconds", "eta_seconds"}
+    assert seen[-1]["done"] == seen[-1]["total"]
+    assert all(b["lo"] == -5 and b["hi"] == 5 for b in result["prior_box"])
+
+
+def no_children_left():
+    try:
+        os.waitpid(-1, os.WNOHANG)
+    except ChildProcessError:
+        return True
+    return False
+
+
+def test_exception_in_the_progress_callback_stops_the_run(recording):
+    _, rec = recording
+
+    def stop(p):
+        if p["done"] >= 2:
+            raise RuntimeError("stopped by the callback")
+
+    with pytest.raises(RuntimeError, match="stopped by the callback"):
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, solver="csdp", threads=2,
+                        progress=stop)
+    assert no_children_left()
+
+
+def test_ctrl_c_stops_a_long_run_promptly_and_cleanly():
+    # Horizon 2, order 2 on all 300 samples takes many minutes; SIGINT arrives one second into it.
+    script = textwrap.dedent(f"""
+        import os, signal, threading, time
+        import numpy as np
+        import hwbounds
+        d = np.loadtxt({CERONE_N300!r}, delimiter=",", skiprows=1)
+        sent = []
+        def progress(p):
+            if not sent:
+                sent.append(time.monotonic() + 1.0)
+                threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT)).start()
+        try:
+            hwbounds.bounds(d[:, 1], d[:, 3], d[:, 4], horizon=2, order=2, threads=2, progress=progress)
+            print("finished")
+        except KeyboardInterrupt:
+            try:
+                os.waitpid(-1, os.WNOHANG)
+                left = "yes"
+            except ChildProcessError:
+                left = "no"
+            print(f"interrupted after {{time.monotonic() - sent[0]:.2f}} s, children left: {{left}}")
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert "interrupted after" in p.stdout and "children left: no" in p.stdout, p.stdout + p.stderr
+    assert float(p.stdout.split("after ")[1].split(" s")[0]) < 3.0, p.stdout

@@ -1,0 +1,118 @@
+"""MATLAB recordings through the shared spec: files written by scipy.io.savemat (v5) and h5py (v7.3) read
+back to the samples of their CSV twin, from Python and from the CLI; bad input names file, variable, fault."""
+import os
+
+import h5py
+import numpy as np
+import pytest
+import scipy.io
+
+import hwbounds
+from conftest import TEST_DATA, cli_error, run_cli
+
+N = 50
+
+
+@pytest.fixture
+def twin(tmp_path):
+    """A recording as CSV (all digits) and its arrays."""
+    rng = np.random.default_rng(3)
+    rec = {"t": np.arange(N) * 0.1, "u": rng.normal(size=N), "y": rng.normal(size=N)}
+    path = tmp_path / "rec.csv"
+    with open(path, "w") as f:
+        f.write("t,u,y\n")
+        for i in range(N):
+            f.write(",".join(repr(float(rec[k][i])) for k in ("t", "u", "y")) + "\n")
+    return str(path), rec
+
+
+def write_v73(path, variables):
+    """A MATLAB v7.3 file as MATLAB writes it: HDF5 with a 512-byte user block holding the MAT header, every
+    dataset transposed (MATLAB is column-major) with a null-terminated MATLAB_class attribute."""
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, array in variables.items():
+            ds = f.create_dataset(name, data=np.atleast_2d(array))
+            tid = h5py.h5t.C_S1.copy()
+            tid.set_size(6)
+            tid.set_strpad(h5py.h5t.STR_NULLTERM)
+            attr = h5py.h5a.create(ds.id, b"MATLAB_class", tid, h5py.h5s.create(h5py.h5s.SCALAR))
+            attr.write(np.array(b"double", dtype="S6"), mtype=tid)
+    with open(path, "r+b") as f:
+        f.write(b"MATLAB 7.3 MAT-file, written by the hwbounds tests".ljust(116) + b"\0" * 8 + b"\x00\x02IM")
+
+
+def test_savemat_v5_reads_back_like_its_csv_twin(twin, tmp_path):
+    csv, rec = twin
+    mat = tmp_path / "rec_v5.mat"
+    scipy.io.savemat(mat, {"time": rec["t"], "vir": rec["u"].reshape(N, 1), "qm": rec["y"]})
+    got = hwbounds.read_recording(f"{mat}:u=vir,y=qm,t=time")
+    want = hwbounds.read_recording(csv)
+    for k in ("t", "u", "y"):
+        np.testing.assert_array_equal(got[k], want[k])
+        np.testing.assert_array_equal(got[k], rec[k])
+
+
+def test_h5py_v73_reads_back_like_its_csv_twin(twin, tmp_path):
+    csv, rec = twin
+    mat = tmp_path / "rec_v73.mat"
+    write_v73(mat, {"u": rec["u"], "y": rec["y"], "t": rec["t"]})
+    got = hwbounds.read_recording(str(mat))  # variables named as the columns: no map needed
+    for k in ("t", "u", "y"):
+        np.testing.assert_array_equal(got[k], rec[k])
+
+
+def test_committed_fixtures_match_their_csv_twin():
+    want = hwbounds.read_recording(os.path.join(TEST_DATA, "recording.csv"))
+    for name in ("recording_v5.mat", "recording_v73.mat"):
+        got = hwbounds.read_recording(os.path.join(TEST_DATA, name) + ":u=vir,y=qm,t=time")
+        for k in ("t", "u", "y"):
+            np.testing.assert_array_equal(got[k], want[k])
+
+
+def test_cli_reads_the_mat_file_like_the_csv(twin, tmp_path):
+    csv, rec = twin
+    mat = tmp_path / "rec.mat"
+    scipy.io.savemat(mat, {"vin": rec["u"]})
+    model = tmp_path / "model.json"
+    model.write_text('{"type": "hammerstein_wiener", "input_nonlinearity": {"kind": "polynomial", '
+                     '"coefficients": [1, 0.2]}, "linear": {"a": [-0.6], "b": [0, 1]}}')
+    run_cli("simulate", "--model", model, "--input", csv, "--out", tmp_path / "a.csv")
+    run_cli("simulate", "--model", model, "--input", f"{mat}:u=vin", "--out", tmp_path / "b.csv")
+    a = hwbounds.read_recording(str(tmp_path / "a.csv"), ["w"], [])
+    b = hwbounds.read_recording(str(tmp_path / "b.csv"), ["w"], [])
+    np.testing.assert_array_equal(a["w"], b["w"])
+
+
+@pytest.mark.parametrize("variables, spec, message", [
+    ({"vir": np.ones(5)}, ":u=vin,y=vir", "no variable 'vin'; the file has: vir (1x5 double)"),
+    ({"m": np.ones((3, 4)), "y": np.ones(3)}, ":u=m", "variable 'm' is a 3x4 double array; a recording variable "
+                                                      "must be a vector"),
+    ({"u": "text", "y": np.ones(4)}, "", "variable 'u' is a 1x4 char array; a recording variable must be numeric"),
+    ({"u": np.array([1.0, np.nan, 2.0]), "y": np.ones(3)}, "", "variable 'u' sample 2 is nan; every sample must be "
+                                                             "a finite number"),
+    ({"u": np.ones(4), "y": np.ones(3)}, "", "variable 'y' has 3 samples but 'u' has 4"),
+    ({"u": np.ones(3)}, "", "no variable 'y' for the column y; name its variable as"),
+])
+def test_bad_mat_input_names_file_variable_and_fault(tmp_path, variables, spec, message):
+    mat = tmp_path / "bad.mat"
+    scipy.io.savemat(mat, variables)
+    with pytest.raises(ValueError) as e:
+        hwbounds.read_recording(f"{mat}{spec}")
+    assert str(mat) in str(e.value)
+    assert message in str(e.value)
+    # The CLI says the same, with exit code 2 (diagnose reads u, y and optionally t, as read_recording's default).
+    assert message in cli_error("diagnose", "--data", f"{mat}{spec}", "--validate", f"{mat}{spec}",
+                                "--fit", "linear:1,1", "--out", tmp_path / "d")
+
+
+def test_arrays_from_python_are_checked_like_recordings():
+    model = {"linear": {"a": [-0.5], "b": [0, 1]}}
+    with pytest.raises(ValueError, match=r"u: sample 3 is nan; every sample must be a finite number"):
+        hwbounds.simulate(model, [1.0, 2.0, float("nan")])
+    with pytest.raises(ValueError, match=r"u: expected a 1-D array \(a vector\), got shape \(2, 3\)"):
+        hwbounds.simulate(model, np.ones((2, 3)))
+    np.testing.assert_array_equal(hwbounds.simulate(model, np.ones((4, 1))), hwbounds.simulate(model, np.ones(4)))
+    with pytest.raises(ValueError, match=r"ident: unknown key 'z'; expected u, y and optionally t"):
+        hwbounds.diagnose({"u": np.ones(80), "y": np.ones(80), "z": np.ones(80)}, "x.csv", fit="linear:1,1")
+    with pytest.raises(ValueError, match=r"ident: 'y' has 79 samples but 'u' has 80"):
+        hwbounds.diagnose({"u": np.ones(80), "y": np.ones(79)}, "x.csv", fit="linear:1,1")
