@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 #include "estimators/brouri/experiment.hpp"
 
 namespace hw::cli {
@@ -20,18 +21,33 @@ namespace {
 namespace fs = std::filesystem;
 using namespace hw::brouri;
 
-nlohmann::json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+nlohmann::json ReadJson(const std::string& path) { return ReadJsonFile(path, "JSON file"); }
+
+// Runs a reader of JSON contents, prefixing its errors with the file they came from.
+template <class Read>
+auto FromFile(const std::string& path, Read&& read) {
   try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
+    return read();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()));
   }
 }
 
+// The stage-1 estimate from a `brouri estimate` result: the stage-1 file itself, or a stage-2 file's copy.
+NonlinearEstimate ReadNonlinearEstimate(const std::string& path) {
+  const auto j = ReadJson(path);
+  return FromFile(path, [&] {
+    if (j.is_object() && j.contains("nonlinear")) {
+      CheckKeys(j, {"stage", "points", "nonlinear", "note"}, "stage-2 result");
+      return NonlinearEstimate::from_json(j.at("nonlinear"));
+    }
+    return NonlinearEstimate::from_json(j, {"stage", "summary"});
+  });
+}
+
 std::string PlanStage(const nlohmann::json& j, const std::string& path) {
-  if (j.value("method", std::string()) != "brouri" || !j.contains("stage"))
+  if (!j.is_object() || !j.contains("method") || j.at("method") != "brouri" || !j.contains("stage") ||
+      !j.at("stage").is_string())
     throw InputError(fmt::format("{}: not a brouri plan (expected \"method\": \"brouri\" and a \"stage\"); write one "
                                  "with `hwbounds brouri plan steps|sines`",
                                  path));
@@ -110,8 +126,7 @@ void AddBrouriPlan(CLI::App& brouri) {
       ->check(CLI::NonNegativeNumber);
   sines->add_option("--out-dir", si->out_dir, "directory for plan.json and sine_<i>.csv")->required();
   sines->callback([si] {
-    const auto j = ReadJson(si->nonlinear);
-    const NonlinearEstimate est = NonlinearEstimate::from_json(j.contains("nonlinear") ? j.at("nonlinear") : j);
+    const NonlinearEstimate est = ReadNonlinearEstimate(si->nonlinear);
     std::vector<double> omegas = si->omegas;
     std::sort(omegas.begin(), omegas.end());
     const SinePlan p = MakeSinePlan(est, omegas, si->amplitude, si->spp, si->periods, si->settling);
@@ -165,7 +180,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
     auto path_of = [&](const std::string& file) { return (fs::path(dir.empty() ? "." : dir) / file).string(); };
     nlohmann::json result;
     if (stage == "steps") {
-      const StepPlan plan = StepPlan::from_json(j);
+      const StepPlan plan = FromFile(o->plan, [&] { return StepPlan::from_json(j); });
       NonlinearOptions opt;
       opt.degree = o->degree;
       opt.max_degree = o->max_degree;
@@ -193,7 +208,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
       result["stage"] = "steps";
       result["summary"] = s.message;
     } else {
-      const SinePlan plan = SinePlan::from_json(j);
+      const SinePlan plan = FromFile(o->plan, [&] { return SinePlan::from_json(j); });
       FrequencyOptions opt;
       opt.harmonic = o->harmonic;
       opt.zoh_correction = !o->no_zoh;
@@ -238,7 +253,8 @@ void AddBrouriSimulate(CLI::App& brouri) {
     const auto j = ReadJson(o->plan);
     const auto stage = PlanStage(j, o->plan);
     BacklashHwSystem sys =
-        o->system.empty() ? BacklashHwSystem::PaperExample() : BacklashHwSystem::from_json(ReadJson(o->system));
+        o->system.empty() ? BacklashHwSystem::PaperExample()
+                          : FromFile(o->system, [&] { return BacklashHwSystem::from_json(ReadJson(o->system)); });
     if (!std::isnan(o->noise_std)) sys.noise_std = o->noise_std;
     const std::string dir = o->out_dir.empty() ? fs::path(o->plan).parent_path().string() : o->out_dir;
     if (!dir.empty()) fs::create_directories(dir);
@@ -254,10 +270,10 @@ void AddBrouriSimulate(CLI::App& brouri) {
       fmt::print("wrote {} ({} samples)\n", path, u.size());
     };
     if (stage == "steps") {
-      const StepPlan p = StepPlan::from_json(j);
+      const StepPlan p = FromFile(o->plan, [&] { return StepPlan::from_json(j); });
       write(p.file, p.sample_time, p.Input(), nullptr, o->seed);
     } else {
-      const SinePlan p = SinePlan::from_json(j);
+      const SinePlan p = FromFile(o->plan, [&] { return SinePlan::from_json(j); });
       for (std::size_t i = 0; i < p.experiments.size(); ++i) {
         const auto z = p.Command(i);
         write(p.experiments[i].file, p.experiments[i].sample_time(), p.Input(i), &z, o->seed + 1000 + i);

@@ -1,6 +1,8 @@
 #include "core/csv_table.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -97,12 +99,22 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
   return table;
 }
 
-CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+std::string read_text_file(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status)) throw InputError(fmt::format("{}: no such file; expected a {}", path, what));
+  if (fs::is_directory(status)) throw InputError(fmt::format("{}: is a directory; expected a {}", path, what));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open ({}); expected a readable {}", path, std::strerror(errno), what));
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_csv(ss.str(), path, allow_nonfinite);
+  if (in.bad()) throw InputError(fmt::format("{}: read error; expected a readable {}", path, what));
+  return ss.str();
+}
+
+CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
+  return parse_csv(read_text_file(path, "CSV file"), path, allow_nonfinite);
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {

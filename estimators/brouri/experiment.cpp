@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 
 namespace hw::brouri {
 
@@ -66,6 +67,9 @@ nlohmann::json StepPlan::to_json() const {
 
 StepPlan StepPlan::from_json(const nlohmann::json& j) {
   return ParseValidated<StepPlan>("step plan", [&] {
+    CheckKeys(j, {"method", "stage", "sample_time", "hold_samples", "average_samples", "reset_level", "levels_up",
+                  "levels_down", "file"},
+              "step plan");
     StepPlan p;
     p.sample_time = j.at("sample_time").get<double>();
     p.hold_samples = j.at("hold_samples").get<int>();
@@ -139,9 +143,12 @@ nlohmann::json SinePlan::to_json() const {
 
 SinePlan SinePlan::from_json(const nlohmann::json& j) {
   return ParseValidated<SinePlan>("sine plan", [&] {
+    CheckKeys(j, {"method", "stage", "amplitude", "experiments", "nonlinear"}, "sine plan");
     SinePlan p;
     p.amplitude = j.at("amplitude").get<double>();
     for (const auto& e : j.at("experiments")) {
+      CheckKeys(e, {"omega", "sample_time", "samples_per_period", "transient_periods", "periods", "file"},
+                "sine plan: experiments[]");
       SineExperiment x;
       x.omega = e.at("omega").get<double>();
       x.samples_per_period = e.at("samples_per_period").get<int>();

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 
 namespace hw::brouri {
 
@@ -318,6 +319,7 @@ nlohmann::json HoldJson(const HoldAverage& h) {
           {"samples", h.samples},     {"hold_mean", h.hold_mean}, {"hold_std_error", h.hold_std_error}};
 }
 HoldAverage HoldFromJson(const nlohmann::json& j) {
+  CheckKeys(j, {"level", "mean", "std_error", "samples", "hold_mean", "hold_std_error"}, "nonlinear estimate: hold");
   return {j.at("level").get<double>(), j.at("mean").get<double>(), j.at("std_error").get<double>(),
           j.at("samples").get<int>(), j.value("hold_mean", 0.0), j.value("hold_std_error", 0.0)};
 }
@@ -352,8 +354,14 @@ nlohmann::json NonlinearEstimate::to_json() const {
   return j;
 }
 
-NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j) {
+NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j,
+                                                const std::vector<std::string_view>& extension_keys) {
   try {
+    std::vector<std::string_view> keys = {"operator", "degree", "j_a", "j_d", "params", "lines",
+                                          "descending_readings", "h", "joint_refit", "paper_lines", "q_up",
+                                          "q_down", "reset", "up", "down", "warnings"};
+    keys.insert(keys.end(), extension_keys.begin(), extension_keys.end());
+    CheckKeys(j, keys, "nonlinear estimate");
     NonlinearEstimate e;
     const auto op = j.at("operator").get<std::string>();
     if (op != "backlash" && op != "backlash-inverse")
@@ -363,6 +371,17 @@ NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j) {
     e.j_a = j.value("j_a", 0);
     e.j_d = j.value("j_d", 0);
     const auto& pj = j.at("params");
+    CheckKeys(pj, {"S_a", "d_plus", "S_d", "d_minus"}, "nonlinear estimate: params");
+    // Derived records (recomputed from params, not read) must still hold only their own keys.
+    for (const char* lines : {"lines", "paper_lines"})
+      if (j.contains(lines))
+        CheckKeys(j.at(lines), {"slope_up", "root_up", "slope_down", "root_down"}, std::string("nonlinear estimate: ") + lines);
+    if (j.contains("descending_readings")) {
+      const auto& r = j.at("descending_readings");
+      CheckKeys(r, {"paper_coefficients", "leading_and_root", "root_and_slope"}, "nonlinear estimate: descending_readings");
+      for (const auto& [name, reading] : r.items())
+        CheckKeys(reading, {"S_d", "d_minus"}, "nonlinear estimate: descending_readings: " + name);
+    }
     e.params = {pj.at("S_a").get<double>(), pj.at("d_plus").get<double>(), pj.at("S_d").get<double>(),
                 pj.at("d_minus").get<double>()};
     e.lines = LinesOf(e.kind, e.params);

@@ -27,6 +27,7 @@
 // A backlash-inverse input (eq. 2) has no plateau (j_a = j_d = 0) and its "up" line lies LEFT of its
 // "down" line; the estimator reads the operator kind from that order, it is not told.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -84,7 +85,9 @@ struct NonlinearEstimate {
   std::string warnings;
 
   nlohmann::json to_json() const;
-  static NonlinearEstimate from_json(const nlohmann::json& j);  // throws InputError
+  // Throws InputError, also for an unknown key; `extension_keys` are keys of an enclosing record the caller
+  // reads itself (the stage-1 result file adds "stage" and "summary").
+  static NonlinearEstimate from_json(const nlohmann::json& j, const std::vector<std::string_view>& extension_keys = {});
   // The pre-compensator of Fig. 8 that cancels the estimated operator (see the .cpp for the
   // backlash-inverse plant, where the paper's Lemma 1 overstates what a backlash can do).
   MemoryOperator Precompensator() const;
