@@ -104,6 +104,7 @@ void AddBoundsCommand(CLI::App& app) {
     const CsvTable table = read_csv(o->data);
     relax::HwData data;
     data.source = o->data;
+    data.lines = table.lines;
     data.u = table.column(o->u_col);
     data.y = table.column(o->y_col);
     if (!o->noise_col.empty()) {
@@ -124,6 +125,7 @@ void AddBoundsCommand(CLI::App& app) {
     if (!structure.IsValid(&error)) throw InputError(error);
     const auto names = relax::MakeLayout(structure).names;
     relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
+    for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
 
     relax::BoundsOptions options;
     options.order = o->order > 0 ? o->order : std::max(1, (o->horizon + 2) / 2);
@@ -207,6 +209,7 @@ void AddBoundsCommand(CLI::App& app) {
     if (!o->json_out.empty()) {
       auto j = summary.to_json();
       j["data"] = o->data;
+      j["data_warnings"] = set.warnings();
       j["structure"] = {{"na", o->na}, {"nb", o->nb}, {"proper", o->proper}, {"input_basis", o->input_basis},
                         {"output_basis", o->output_basis}};
       if (!truth.empty()) {

@@ -93,6 +93,7 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
                                      c < cells.size() && !cells[c].empty() ? cells[c] : "empty"));
       table.columns[c].push_back(v);
     }
+    table.lines.push_back(line_no);
   }
   if (!have_header) throw InputError(fmt::format("{}: empty file; expected a header line and data rows", source));
   if (table.rows() == 0) throw InputError(fmt::format("{}: header but no data rows", source));

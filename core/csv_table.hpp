@@ -17,6 +17,7 @@ struct CsvTable {
   std::string source;                      // file name, for messages
   std::vector<std::string> names;          // header, in file order
   std::vector<std::vector<double>> columns;
+  std::vector<int> lines;                  // file line (1-based) of each data row, for messages; may be empty
 
   std::size_t rows() const { return columns.empty() ? 0 : columns.front().size(); }
   bool has(const std::string& name) const;
