@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "relax/set_membership.hpp"
 
 namespace hw::cli {
@@ -73,18 +74,23 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--data", o->data, "recording CSV with a header")->required();
   cmd->add_option("--u-col", o->u_col, "input column");
   cmd->add_option("--y-col", o->y_col, "output column");
-  cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value");
-  cmd->add_option("--noise-col", o->noise_col, "column with a per-sample noise bound (instead of --noise-bound)");
-  cmd->add_option("--na", o->na, "denominator order");
-  cmd->add_option("--nb", o->nb, "numerator order (b_0..b_nb, b_0 = 0 unless --proper)");
+  auto* noise_bound = cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value")
+                          ->check(CLI::PositiveNumber);
+  auto* noise_col =
+      cmd->add_option("--noise-col", o->noise_col, "column with a per-sample noise bound (instead of --noise-bound)");
+  noise_bound->excludes(noise_col);
+  cmd->add_option("--na", o->na, "denominator order")->check(CLI::Range(1, 20));
+  cmd->add_option("--nb", o->nb, "numerator order (b_0..b_nb, b_0 = 0 unless --proper)")->check(CLI::Range(0, 20));
   cmd->add_flag("--proper", o->proper, "estimate b_0 too (proper, not strictly proper)");
   cmd->add_option("--input-basis", o->input_basis, "psi basis: poly:K or a list like 'w,w^3,tanh'");
   cmd->add_option("--output-basis", o->output_basis, "phi basis of the inverse output map");
-  cmd->add_option("--horizon", o->horizon, "dynamic horizon n");
-  cmd->add_option("--order", o->order, "relaxation order delta (default: minimal order ceil((n+1)/2))");
+  cmd->add_option("--horizon", o->horizon, "dynamic horizon n")->check(CLI::Range(1, 20));
+  cmd->add_option("--order", o->order, "relaxation order delta (default: minimal order ceil((n+1)/2))")
+      ->check(CLI::Range(1, 20));
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI (default -10,10)");
   cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember({"csdp", "sdpa"}));
-  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; default: all cores)");
+  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)")
+      ->check(CLI::Range(0, 4096));
   cmd->add_option("--executor", o->executor,
                   "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "
                   "coordinates, the other ranks solve)")
@@ -101,6 +107,8 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--json", o->json_out, "write the result as JSON");
   cmd->add_flag("--quiet", o->quiet, "no progress lines");
   cmd->callback([o] {
+    if (!o->json_out.empty()) CheckOutputFile(o->json_out, "--json");
+    if (!o->run_dir.empty()) CheckOutputDirectory(o->run_dir, "--run-dir");
     const CsvTable table = read_csv(o->data);
     relax::HwData data;
     data.source = o->data;
@@ -110,9 +118,7 @@ void AddBoundsCommand(CLI::App& app) {
     if (!o->noise_col.empty()) {
       data.noise_bound = table.column(o->noise_col);
     } else {
-      if (!(o->noise_bound > 0))
-        throw InputError(fmt::format("--noise-bound must be a positive number (got {}), or give --noise-col",
-                                     o->noise_bound));
+      if (!(o->noise_bound > 0)) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
       data.noise_bound.assign(data.y.size(), o->noise_bound);
     }
     relax::HwStructure structure;
@@ -127,8 +133,12 @@ void AddBoundsCommand(CLI::App& app) {
     relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
 
+    const int minimal_order = std::max(1, (o->horizon + 2) / 2);
+    if (o->order > 0 && o->order < minimal_order)
+      throw InputError(fmt::format("--order {} is below the minimal order ceil((n+1)/2) = {} of horizon {}", o->order,
+                                   minimal_order, o->horizon));
     relax::BoundsOptions options;
-    options.order = o->order > 0 ? o->order : std::max(1, (o->horizon + 2) / 2);
+    options.order = o->order > 0 ? o->order : minimal_order;
     options.solver = o->solver;
     options.threads = o->threads;
     options.executor = sdp::MakeExecutor(o->executor, o->threads);

@@ -14,6 +14,7 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "core/json_input.hpp"
+#include "core/output_files.hpp"
 #include "estimators/brouri/experiment.hpp"
 
 namespace hw::cli {
@@ -86,6 +87,7 @@ void AddBrouriPlan(CLI::App& brouri) {
       ->check(CLI::Range(2, 100000000));
   steps->add_option("--out-dir", so->out_dir, "directory for plan.json and steps.csv")->required();
   steps->callback([so] {
+    CheckOutputDirectory(so->out_dir, "--out-dir");
     double reset = so->reset;
     if (std::isnan(reset)) {
       if (so->down.empty()) throw InputError("--levels-down is empty");
@@ -93,13 +95,15 @@ void AddBrouriPlan(CLI::App& brouri) {
                        so->up.empty() ? 0.0 : so->up.front() - 1.0);
     }
     const StepPlan p = MakeStepPlan(so->up, so->down, reset, so->ts, so->settling, so->m);
-    fs::create_directories(so->out_dir);
     const auto u = p.Input();
     CsvTable t;
     t.add_column("t", Times(u.size(), p.sample_time));
     t.add_column("u", u);
-    write_csv(so->out_dir + "/" + p.file, t, 15);
-    write_text_atomic(so->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    OutputFiles files;
+    files.Add(so->out_dir + "/" + p.file, format_csv(t, 15));
+    files.Add(so->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    fs::create_directories(so->out_dir);
+    files.Commit();
     fmt::print("stage-1 plan: {} holds of {} samples ({} s each, last M = {} averaged), {} samples = {:.6g} s in all\n",
                p.Levels().size(), p.hold_samples, p.hold_samples * p.sample_time, p.average_samples, u.size(),
                u.size() * p.sample_time);
@@ -126,11 +130,12 @@ void AddBrouriPlan(CLI::App& brouri) {
       ->check(CLI::NonNegativeNumber);
   sines->add_option("--out-dir", si->out_dir, "directory for plan.json and sine_<i>.csv")->required();
   sines->callback([si] {
+    CheckOutputDirectory(si->out_dir, "--out-dir");
     const NonlinearEstimate est = ReadNonlinearEstimate(si->nonlinear);
     std::vector<double> omegas = si->omegas;
     std::sort(omegas.begin(), omegas.end());
     const SinePlan p = MakeSinePlan(est, omegas, si->amplitude, si->spp, si->periods, si->settling);
-    fs::create_directories(si->out_dir);
+    OutputFiles files;
     for (std::size_t i = 0; i < p.experiments.size(); ++i) {
       const auto& e = p.experiments[i];
       CsvTable t;
@@ -138,11 +143,13 @@ void AddBrouriPlan(CLI::App& brouri) {
       t.add_column("t", Times(z.size(), e.sample_time()));
       t.add_column("z", z);
       t.add_column("u", p.Input(i));
-      write_csv(si->out_dir + "/" + e.file, t, 15);
+      files.Add(si->out_dir + "/" + e.file, format_csv(t, 15));
       fmt::print("  {}: omega = {} rad/s, Ts = {:.6g} s, {} transient + {} averaged periods = {:.6g} s\n", e.file,
                  e.omega, e.sample_time(), e.transient_periods, e.periods, e.total_samples() * e.sample_time());
     }
-    write_text_atomic(si->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    files.Add(si->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    fs::create_directories(si->out_dir);
+    files.Commit();
     fmt::print("stage-2 plan ({} pre-compensator for the estimated {}): apply column u of each file, add column y,\n"
                "then run  hwbounds brouri estimate --plan {}/plan.json --out frequency.json\n",
                ToString(est.kind == OperatorKind::kBacklash ? OperatorKind::kBacklashInverse : OperatorKind::kBacklash),
@@ -174,6 +181,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
   cmd->add_flag("--no-zoh-correction", o->no_zoh, "stage 2: do not correct for the hold (sinc gain, Ts/2 delay)");
   cmd->add_option("--out", o->out, "result JSON")->required();
   cmd->callback([o] {
+    CheckOutputFile(o->out, "--out");
     const auto j = ReadJson(o->plan);
     const auto stage = PlanStage(j, o->plan);
     const std::string dir = o->data.empty() ? fs::path(o->plan).parent_path().string() : o->data;
@@ -257,7 +265,8 @@ void AddBrouriSimulate(CLI::App& brouri) {
                           : FromFile(o->system, [&] { return BacklashHwSystem::from_json(ReadJson(o->system)); });
     if (!std::isnan(o->noise_std)) sys.noise_std = o->noise_std;
     const std::string dir = o->out_dir.empty() ? fs::path(o->plan).parent_path().string() : o->out_dir;
-    if (!dir.empty()) fs::create_directories(dir);
+    CheckOutputDirectory(dir.empty() ? "." : dir, "--out-dir");
+    OutputFiles files;
     auto write = [&](const std::string& file, double ts, const std::vector<double>& u, const std::vector<double>* z,
                      std::uint64_t seed) {
       CsvTable t;
@@ -265,9 +274,7 @@ void AddBrouriSimulate(CLI::App& brouri) {
       if (z) t.add_column("z", *z);
       t.add_column("u", u);
       t.add_column("y", Simulate(sys, u, ts, seed).y);
-      const auto path = (fs::path(dir.empty() ? "." : dir) / file).string();
-      write_csv(path, t, 15);
-      fmt::print("wrote {} ({} samples)\n", path, u.size());
+      files.Add((fs::path(dir.empty() ? "." : dir) / file).string(), format_csv(t, 15));
     };
     if (stage == "steps") {
       const StepPlan p = FromFile(o->plan, [&] { return StepPlan::from_json(j); });
@@ -279,6 +286,9 @@ void AddBrouriSimulate(CLI::App& brouri) {
         write(p.experiments[i].file, p.experiments[i].sample_time(), p.Input(i), &z, o->seed + 1000 + i);
       }
     }
+    if (!dir.empty()) fs::create_directories(dir);
+    files.Commit();
+    for (const auto& [path, text] : files.files()) fmt::print("wrote {}\n", path);
   });
 }
 

@@ -5,6 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
 #include "diagnose/diagnose.hpp"
 
@@ -62,6 +63,7 @@ void AddDiagnoseCommand(CLI::App& app) {
   cmd->add_option("--window", o->o.windows.length, "mismatch window length in samples (0 = auto)");
   cmd->add_option("--effects", o->effects, "comma-separated candidates EFFECT@LOCATION (default: all)");
   cmd->callback([o] {
+    CheckOutputDirectory(o->out, "--out");
     if (o->model.empty() == o->fit.empty()) throw InputError("diagnose needs exactly one of --model FILE or --fit SPEC");
     std::string err;
     if (!o->o.IsValid(&err)) throw InputError("diagnose: " + err);

@@ -3,6 +3,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "relax/pop_json.hpp"
 #include "sdp/sdpa_format.hpp"
 
@@ -17,22 +18,26 @@ void AddPopCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("PROBLEM", o->problem, "problem JSON (see README: Polynomial problems)")->required();
-  cmd->add_option("--order", o->order, "relaxation order delta (default: minimal)");
+  cmd->add_option("--order", o->order, "relaxation order delta, at least the problem's minimal order")
+      ->check(CLI::Range(1, 1000000))
+      ->default_str("minimal");
   cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember({"csdp", "sdpa"}));
   cmd->add_option("--export", o->export_path, "also write the SDP in SDPA sparse format (.dat-s)");
   cmd->add_flag("--json", o->json, "machine-readable output");
   cmd->callback([o] {
+    if (!o->export_path.empty()) CheckOutputFile(o->export_path, "--export");
     const auto problem = relax::LoadPolyProblem(o->problem);
     relax::RelaxationOptions options;
     options.order = o->order;
     if (o->order > 0 && o->order < problem.minimal_order())
       throw InputError(fmt::format("--order {} is below this problem's minimal order {}", o->order, problem.minimal_order()));
-    if (!o->export_path.empty()) {
-      const relax::MomentRelaxation relaxation(problem, o->order > 0 ? o->order : problem.minimal_order());
-      sdp::WriteSdpaSparse(o->export_path, relaxation.lmi());
-    }
     auto solver = sdp::MakeSolver(o->solver);
     const auto r = relax::SolveRelaxation(options, problem, *solver);
+    const bool failed = r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid;
+    if (!o->export_path.empty() && !failed) {  // a result file: written only when the command succeeds
+      const relax::MomentRelaxation relaxation(problem, r.order);
+      sdp::WriteSdpaSparse(o->export_path, relaxation.lmi());
+    }
     const auto names = problem.names.empty() ? default_variable_names(problem.num_vars) : problem.names;
     if (o->json) {
       nlohmann::json j = {{"status", relax::ToString(r.status)}, {"message", r.message}, {"order", r.order},
@@ -45,7 +50,7 @@ void AddPopCommand(CLI::App& app) {
         j["minimizers"] = r.minimizers;
         j["rank"] = r.rank;
       }
-      if (!o->export_path.empty()) j["exported"] = o->export_path;
+      if (!o->export_path.empty() && !failed) j["exported"] = o->export_path;
       fmt::print("{}\n", j.dump(2));
     } else {
       fmt::print("order {} relaxation ({} moments, {} blocks), solver {}: {}\n", r.order, r.num_moments, r.num_blocks,
@@ -61,10 +66,9 @@ void AddPopCommand(CLI::App& app) {
       } else {
         fmt::print("{}\n", r.message);
       }
-      if (!o->export_path.empty()) fmt::print("wrote {}\n", o->export_path);
+      if (!o->export_path.empty() && !failed) fmt::print("wrote {}\n", o->export_path);
     }
-    if (r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid)
-      throw std::runtime_error("no valid bound: " + r.message);
+    if (failed) throw std::runtime_error("no valid bound: " + r.message + (o->export_path.empty() ? "" : "; nothing exported"));
   });
 }
 

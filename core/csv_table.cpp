@@ -120,16 +120,23 @@ CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
 
 void write_text_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot write", tmp));
-    out << text;
-    if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
+  std::error_code ec;
+  try {
+    {
+      std::ofstream out(tmp, std::ios::binary);
+      if (!out) throw std::runtime_error(fmt::format("{}: cannot write ({})", tmp, std::strerror(errno)));
+      out << text;
+      out.flush();
+      if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
+    }
+    std::filesystem::rename(tmp, path);
+  } catch (const std::exception& e) {
+    std::filesystem::remove(tmp, ec);  // never leave a half-written file behind
+    throw std::runtime_error(fmt::format("{}: not written: {}", path, e.what()));
   }
-  std::filesystem::rename(tmp, path);
 }
 
-void write_csv(const std::string& path, const CsvTable& table, int precision) {
+std::string format_csv(const CsvTable& table, int precision) {
   std::string out;
   for (std::size_t c = 0; c < table.names.size(); ++c) out += (c ? "," : "") + table.names[c];
   out += '\n';
@@ -138,7 +145,11 @@ void write_csv(const std::string& path, const CsvTable& table, int precision) {
       out += (c ? "," : "") + fmt::format("{:.{}g}", table.columns[c][r], precision);
     out += '\n';
   }
-  write_text_atomic(path, out);
+  return out;
+}
+
+void write_csv(const std::string& path, const CsvTable& table, int precision) {
+  write_text_atomic(path, format_csv(table, precision));
 }
 
 }  // namespace hw

@@ -122,6 +122,21 @@ bool LinearBlock::IsValid(std::string* error) const {
   return true;
 }
 
+bool LinearBlock::is_stable() const {
+  // Step-down recursion: A_m(z) -> A_{m-1}(z) with reflection coefficient k_m = last coefficient of A_m;
+  // all poles lie inside the unit circle iff every |k_m| < 1.
+  std::vector<double> c = {1.0};
+  c.insert(c.end(), a.begin(), a.end());
+  for (std::size_t m = c.size() - 1; m >= 1; --m) {
+    const double k = c[m];
+    if (!(std::abs(k) < 1.0)) return false;
+    std::vector<double> next(m);
+    for (std::size_t i = 0; i < m; ++i) next[i] = (c[i] - k * c[m - i]) / (1.0 - k * k);
+    c = std::move(next);
+  }
+  return true;
+}
+
 std::vector<double> LinearBlock::simulate(const std::vector<double>& x) const {
   const std::size_t n = x.size();
   std::vector<double> z(n, 0.0);

@@ -35,6 +35,9 @@ struct LinearBlock {
   int delay = 0;          // extra input delay in samples
 
   bool IsValid(std::string* error) const;
+  // True when every pole of 1 / (1 + a_1 q^-1 + ... + a_na q^-na) lies strictly inside the unit circle
+  // (Schur-Cohn test); an unstable block's simulation grows without bound.
+  bool is_stable() const;
   // Simulates from rest (zero initial state).
   std::vector<double> simulate(const std::vector<double>& x) const;
 };
