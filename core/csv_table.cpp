@@ -55,7 +55,8 @@ void CsvTable::add_column(const std::string& name, std::vector<double> values) {
 CsvTable parse_csv(const std::string& text, const std::string& source, bool allow_nonfinite) {
   CsvTable table;
   table.source = source;
-  std::istringstream in(text);
+  // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
+  std::istringstream in(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);
   std::string line;
   int line_no = 0;
   bool have_header = false;
@@ -66,18 +67,25 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
     auto cells = split(t);
     if (!have_header) {
       table.names = cells;
-      for (std::size_t i = 0; i < cells.size(); ++i)
+      for (std::size_t i = 0; i < cells.size(); ++i) {
         if (cells[i].empty())
           throw InputError(fmt::format("{}:{}: header column {} has no name; expected a header such as 't,u,y'",
                                        source, line_no, i + 1));
+        for (std::size_t k = 0; k < i; ++k)
+          if (cells[k] == cells[i])
+            throw InputError(fmt::format("{}:{}: the header names column '{}' twice (columns {} and {}); every "
+                                         "column needs its own name",
+                                         source, line_no, cells[i], k + 1, i + 1));
+      }
       table.columns.assign(cells.size(), {});
       have_header = true;
       continue;
     }
-    // Trailing empty cells are allowed (e.g. the WH benchmark's 'fs' column only in row 1).
-    if (cells.size() > table.names.size())
-      throw InputError(fmt::format("{}:{}: {} cells but the header has {} columns", source, line_no,
-                                   cells.size(), table.names.size()));
+    // With allow_nonfinite, missing trailing cells read as NaN (e.g. a column filled in the first row only);
+    // otherwise a short row is an error that counts its cells.
+    if (cells.size() > table.names.size() || (cells.size() < table.names.size() && !allow_nonfinite))
+      throw InputError(fmt::format("{}:{}: {} cells but the header has {} columns ({})", source, line_no,
+                                   cells.size(), table.names.size(), fmt::join(table.names, ", ")));
     for (std::size_t c = 0; c < table.names.size(); ++c) {
       double v = std::nan("");
       if (c < cells.size() && !cells[c].empty()) {

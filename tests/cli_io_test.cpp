@@ -166,6 +166,15 @@ TEST_F(CliIo, DirectoryAsInputFileIsNamed) {
   EXPECT_TRUE(Has(m.output, "is a directory")) << m.output;
 }
 
+TEST_F(CliIo, NegativeNoiseBoundNamesTheFileLine) {
+  CsvTable t = read_csv(Path("rec.csv"));
+  t.columns[2][9] = -0.5;  // data row 10 = file line 11
+  write_csv(Path("neg.csv"), t);
+  const auto r = Cli("bounds --data " + Path("neg.csv") + " --noise-col noise_bound --horizon 1 --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_TRUE(Has(r.output, "neg.csv:11")) << r.output;
+}
+
 }  // namespace
 }  // namespace hw
 #endif

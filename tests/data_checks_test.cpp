@@ -1,5 +1,5 @@
 // Recordings whose numbers the constraints cannot carry are errors naming the sample's file line (issue
-// item 3).
+// item 3), and the CSV reader's edge cases say what is wrong where (item 9).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -91,6 +91,37 @@ TEST(NoiseBound, NegativeValueNamesTheFileLine) {
   d.noise_bound[6] = -0.1;
   const std::string e = ErrorOf([&] { Set(d); });
   EXPECT_TRUE(Has(e, "rec.csv:8")) << e;
+}
+
+TEST(CsvEdgeCases, DirectoryIsNamedAsADirectory) {
+  const std::string dir = ::testing::TempDir() + "/a_directory.csv";
+  std::filesystem::create_directories(dir);
+  const std::string e = ErrorOf([&] { read_csv(dir); });
+  EXPECT_TRUE(Has(e, dir)) << e;
+  EXPECT_TRUE(Has(e, "is a directory")) << e;
+  const std::string missing = ErrorOf([&] { read_csv(dir + "/none.csv"); });
+  EXPECT_TRUE(Has(missing, "no such file")) << missing;
+}
+
+TEST(CsvEdgeCases, DuplicateColumnNamesAreAnError) {
+  const std::string e = ErrorOf([&] { parse_csv("t,u,y,u\n0,1,2,3\n", "d.csv"); });
+  EXPECT_TRUE(Has(e, "d.csv:1")) << e;
+  EXPECT_TRUE(Has(e, "'u' twice (columns 2 and 4)")) << e;
+}
+
+TEST(CsvEdgeCases, ShortRowCountsItsCells) {
+  const std::string e = ErrorOf([&] { parse_csv("# c\nt,u,y\n0,1,2\n1,2\n", "d.csv"); });
+  EXPECT_TRUE(Has(e, "d.csv:4: 2 cells but the header has 3 columns")) << e;
+  // An explicitly empty cell is still named by its column.
+  const std::string empty = ErrorOf([&] { parse_csv("t,u,y\n0,,2\n", "d.csv"); });
+  EXPECT_TRUE(Has(empty, "column 'u' is empty")) << empty;
+  EXPECT_EQ(parse_csv("t,u,y\n0,1,2\n1,2\n", "d.csv", true).column("y").size(), 2u);  // NaN allowed
+}
+
+TEST(CsvEdgeCases, ByteOrderMarkAndLineNumbers) {
+  const auto t = parse_csv("\xEF\xBB\xBFt,u\n# c\n0,1\n\n1,2\n", "d.csv");
+  EXPECT_TRUE(t.has("t"));
+  EXPECT_EQ(t.lines, (std::vector<int>{3, 5}));
 }
 
 }  // namespace
