@@ -5,9 +5,33 @@
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
 #include "relax/pop_json.hpp"
+#include "relax/relaxation_size.hpp"
 #include "sdp/sdpa_format.hpp"
 
 namespace hw::cli {
+namespace {
+
+// Refuses, with the numbers, a relaxation whose estimated memory exceeds what the machine has now; says the
+// size of a large one that fits before building it.
+void CheckRelaxationFits(const relax::PolyProblem& problem, int order) {
+  const auto size = relax::EstimateRelaxationSize(problem, order);
+  const double available = relax::AvailableMemoryBytes();
+  if (size.bytes > available) {
+    int fits = order;
+    while (fits > problem.minimal_order() && relax::EstimateRelaxationSize(problem, fits).bytes > available) --fits;
+    const auto largest = relax::EstimateRelaxationSize(problem, fits);
+    throw InputError(fmt::format(
+        "--order {}: the relaxation of this {}-variable problem is too large: {}, more than the {} of memory available; "
+        "{}",
+        order, problem.num_vars, size.describe(), relax::FormatBytes(available),
+        largest.bytes <= available
+            ? fmt::format("the largest order that fits is {} ({})", fits, relax::FormatBytes(largest.bytes))
+            : "even the minimal order does not fit"));
+  }
+  if (size.bytes > 1e8) fmt::print(stderr, "order {} relaxation: {}\n", order, size.describe());
+}
+
+}  // namespace
 
 void AddPopCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("pop", "Moment (Lasserre) relaxation of a polynomial optimisation problem (JSON)");
@@ -31,6 +55,7 @@ void AddPopCommand(CLI::App& app) {
     options.order = o->order;
     if (o->order > 0 && o->order < problem.minimal_order())
       throw InputError(fmt::format("--order {} is below this problem's minimal order {}", o->order, problem.minimal_order()));
+    CheckRelaxationFits(problem, o->order > 0 ? o->order : problem.minimal_order());
     auto solver = sdp::MakeSolver(o->solver);
     const auto r = relax::SolveRelaxation(options, problem, *solver);
     const bool failed = r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid;

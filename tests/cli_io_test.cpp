@@ -157,6 +157,19 @@ TEST_F(CliIo, ScenarioWritesAllThreeFilesOrNone) {
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_NE(e.path().extension(), ".tmp") << e.path();
 }
 
+TEST_F(CliIo, HugePopOrderIsRefusedWithItsNumbers) {
+  std::ofstream(Path("p.json")) << R"({"variables":["x1"],"minimize":"x1","constraints":["x1 >= 4","x1 <= 9"]})";
+  std::ofstream(Path("p3.json")) << R"({"variables":["x1","x2","x3"],"minimize":"x1","constraints":["x1 >= 4"]})";
+  const auto r = Cli("pop " + Path("p3.json") + " --order 1000");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_TRUE(Has(r.output, "moments")) << r.output;
+  EXPECT_TRUE(Has(r.output, "memory available")) << r.output;
+  EXPECT_TRUE(Has(r.output, "largest order that fits")) << r.output;
+  EXPECT_LT(r.seconds, 10.0) << "the refusal must come before any allocation";
+  const auto small = Cli("pop " + Path("p.json") + " --order 3");
+  EXPECT_EQ(small.code, 0) << small.output;
+}
+
 TEST_F(CliIo, DirectoryAsInputFileIsNamed) {
   fs::create_directories(Path("recdir"));
   const auto r = Cli("bounds --data " + Path("recdir") + " --noise-bound 0.1 --quiet");
