@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // --help exits 0; every other parse error is bad input, exit status 2 as for InputError.
     return app.exit(e) == 0 ? 0 : 2;
+  } catch (const hw::cli::CommandExit& e) {
+    return e.code;
   } catch (const hw::InputError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;
