@@ -78,8 +78,8 @@ void AddBrouriPlan(CLI::App& brouri) {
   auto* steps = plan->add_subcommand("steps", "Stage 1: reset hold, ascending holds, descending holds");
   steps->add_option("--levels-up", so->up, "ascending levels U_1 < ... < U_N (comma list)")->required()->delimiter(',');
   steps->add_option("--levels-down", so->down, "descending levels (comma list, decreasing)")->required()->delimiter(',');
-  steps->add_option("--reset", so->reset,
-                    "reset level applied first (below U_1; default: the lowest descending level)");
+  steps->add_option("--reset", so->reset, "reset level applied first (below U_1)")
+      ->default_str("the lowest descending level");
   steps->add_option("--sample-time", so->ts, "sample time Ts (s)")->check(CLI::PositiveNumber);
   steps->add_option("--settling-time", so->settling, "upper bound on the settling time of G (s): each hold waits this long")
       ->check(CLI::PositiveNumber);
@@ -167,7 +167,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
   auto o = std::make_shared<Opts>();
   auto* cmd = brouri.add_subcommand("estimate", "Estimate from recordings of a plan (stage 1 or 2, read from the plan)");
   cmd->add_option("--plan", o->plan, "plan.json written by `brouri plan`")->required();
-  cmd->add_option("--data", o->data, "directory of the recordings (default: the plan's directory)");
+  cmd->add_option("--data", o->data, "directory of the recordings")->default_str("the plan's directory");
   cmd->add_option("--y-col", o->y_col, "name of the measured-output column");
   cmd->add_option("--degree", o->degree, "stage 1: degree p of h (0 = select from the data)")->check(CLI::Range(0, 15));
   cmd->add_option("--max-degree", o->max_degree, "stage 1: largest degree the selection tries")->check(CLI::Range(1, 15));
@@ -253,10 +253,11 @@ void AddBrouriSimulate(CLI::App& brouri) {
   auto o = std::make_shared<Opts>();
   auto* cmd = brouri.add_subcommand("simulate", "Record a plan on a simulated system (adds column y to the plan's CSVs)");
   cmd->add_option("--plan", o->plan, "plan.json")->required();
-  cmd->add_option("--system", o->system, "system JSON (default: the paper's Section 6 system; see docs/brouri.md)");
-  cmd->add_option("--noise-std", o->noise_std, "override the system's output noise standard deviation");
+  cmd->add_option("--system", o->system, "system JSON (see docs/brouri.md)")->default_str("the paper's Section 6 system");
+  cmd->add_option("--noise-std", o->noise_std, "override the system's output noise standard deviation")
+      ->default_str("the system's");
   cmd->add_option("--seed", o->seed, "noise seed");
-  cmd->add_option("--out-dir", o->out_dir, "directory for the recordings (default: the plan's directory)");
+  cmd->add_option("--out-dir", o->out_dir, "directory for the recordings")->default_str("the plan's directory");
   cmd->callback([o] {
     const auto j = ReadJson(o->plan);
     const auto stage = PlanStage(j, o->plan);

@@ -20,9 +20,10 @@ void AddScenarioCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--hidden-effect", o->effect, "effect name (docs/diagnose.md) or none")->required();
-  cmd->add_option("--location", o->location, "input, output or state (default: the effect's usual location)");
+  cmd->add_option("--location", o->location, "input, output or state")->default_str("the effect's usual location");
   cmd->add_option("--effect-rms-ratio", o->s.effect_rms_ratio, "effect RMS / noise standard deviation");
-  cmd->add_option("--effect-fraction", o->s.effect_fraction, "effect RMS / std of the linear output (0 = random 4-8 %)");
+  cmd->add_option("--effect-fraction", o->s.effect_fraction, "effect RMS / std of the linear output (0 = random 4-8 %)")
+      ->default_str("random 4-8 %");
   cmd->add_option("--samples", o->s.samples, "samples per recording");
   cmd->add_option("--seed", o->s.seed, "random seed");
   cmd->add_option("--out", o->out, "output prefix, e.g. runs/backlash1")->required();

@@ -10,6 +10,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"hwbounds: set-membership bounds, estimators and diagnosis for Hammerstein-Wiener systems"};
   app.require_subcommand(1);
+  // Every option's help shows its default; options whose default is computed say how (default_str).
+  app.option_defaults()->always_capture_default();
   hw::cli::AddSimulateCommand(app);
   hw::cli::AddBoundsCommand(app);
   hw::cli::AddPopCommand(app);

@@ -188,6 +188,22 @@ TEST_F(CliIo, NegativeNoiseBoundNamesTheFileLine) {
   EXPECT_TRUE(Has(r.output, "neg.csv:11")) << r.output;
 }
 
+TEST_F(CliIo, HelpShowsDefaultsAndTheVerifyPair) {
+  const auto r = Cli("bounds --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_FALSE(Has(r.output, "{false}")) << r.output;
+  EXPECT_TRUE(Has(r.output, "--no-verify")) << r.output;
+  EXPECT_TRUE(Has(r.output, "TEXT=poly:3")) << r.output;  // --input-basis
+  EXPECT_TRUE(Has(r.output, "=minimal")) << r.output;     // --order
+  EXPECT_TRUE(Has(r.output, "=sdpa")) << r.output;        // --solver
+  EXPECT_TRUE(Has(r.output, "Exit status")) << r.output;
+  EXPECT_TRUE(Has(r.output, "3 model invalidated")) << r.output;
+  const auto both = Cli(Bounds("--verify --no-verify"));
+  EXPECT_NE(both.code, 0) << both.output;
+  const auto sim = Cli("simulate --help");
+  EXPECT_TRUE(Has(sim.output, "=1000")) << sim.output;  // --samples
+}
+
 }  // namespace
 }  // namespace hw
 #endif
