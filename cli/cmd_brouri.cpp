@@ -226,6 +226,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
         const auto rec = ReadRecording(path_of(e.file), e.sample_time(), o->y_col);
         Summary s;
         points.push_back(EstimateFromSine(plan, i, opt, rec.u, rec.y, &s));
+        if (!points.back().outliers.empty()) fmt::print("{}\n", s.message);
       }
       UnwrapPhases(&points);
       fmt::print("{:>10} {:>10} {:>12} {:>9} {:>9}\n", "omega", "|G^|", "phi^ (rad)", "harmonic", "misfit");

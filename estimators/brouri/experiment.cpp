@@ -9,6 +9,7 @@
 
 #include "core/csv_table.hpp"
 #include "core/json_input.hpp"
+#include "estimators/brouri/outliers.hpp"
 
 namespace hw::brouri {
 
@@ -212,6 +213,13 @@ NonlinearEstimate EstimateFromSteps(const StepPlan& plan, const NonlinearOptions
   return est;
 }
 
+namespace {
+std::vector<std::size_t> OneBased(std::vector<std::size_t> v) {
+  for (auto& i : v) ++i;
+  return v;
+}
+}  // namespace
+
 FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const FrequencyOptions& options,
                                 const std::vector<double>& u, const std::vector<double>& y, Summary* summary) {
   const auto& e = plan.experiments.at(i);
@@ -230,10 +238,18 @@ FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const Frequ
                                  std::max(0.0, (static_cast<double>(y.size()) -
                                                 e.transient_periods * e.samples_per_period) /
                                                    e.samples_per_period)));
+  std::vector<std::size_t> outliers;
   const auto period = PeriodicAverage(y, static_cast<std::size_t>(e.transient_periods) * e.samples_per_period,
-                                      e.samples_per_period, e.periods);
+                                      e.samples_per_period, e.periods, &outliers);
   FrequencyPoint pt;
   EstimateFrequencyPoint(options, plan.nonlinear.h, plan.amplitude, e.omega, e.sample_time(), period, &pt, summary);
+  pt.outliers = outliers;
+  if (!outliers.empty())
+    summary->message += fmt::format("; warning: {}: sample{} {} left out of the periodic average as isolated "
+                                    "outlier{} (more than {:g} robust standard deviations from the phase's median "
+                                    "over the periods)",
+                                    e.file, outliers.size() > 1 ? "s" : "", fmt::join(OneBased(outliers), ", "),
+                                    outliers.size() > 1 ? "s" : "", kOutlierSigmas);
   return pt;
 }
 

@@ -36,7 +36,8 @@
 
 namespace hw::brouri {
 
-// Eq. 9 on one hold: mean of its last `average_samples` samples, and the standard error of that mean.
+// Eq. 9 on one hold: mean of its last `average_samples` samples, and the standard error of that mean; isolated
+// outliers are left out and listed.
 struct HoldAverage {
   double level = 0.0;   // U_j
   double mean = 0.0;    // X^_j(M)
@@ -45,6 +46,10 @@ struct HoldAverage {
   // Over the WHOLE hold: on a plateau v does not move, so y is flat from the hold's first sample and
   // all of it can be compared with the reference; this gives the plateau test far more samples than M.
   double hold_mean = 0.0, hold_std_error = 0.0;
+  // Isolated outliers (estimators/brouri/outliers.hpp) left out of both averages: 0-based sample indices of
+  // the recording, ascending; and the median of the settled part they were judged against.
+  std::vector<std::size_t> outliers;
+  double median = 0.0;
 };
 // Holds are consecutive blocks of `hold_samples` samples of y starting at sample 0.
 std::vector<HoldAverage> AverageHolds(const std::vector<double>& y, const std::vector<double>& levels,
