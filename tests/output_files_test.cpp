@@ -80,5 +80,38 @@ void ExpectWellFormedTables(const std::string& md) {
   }
 }
 
+TEST(ReadableOutputs, SummaryTablesEscapeBars) {
+  nlohmann::json s = {{"scenario", "x"}, {"description", "d"}, {"runs", 1}, {"methods", nlohmann::json::object()}};
+  s["methods"]["brouri"] = {
+      {"applicable", true}, {"runs_ok", 1}, {"failures", nlohmann::json::array()},
+      {"quantities", {{"freq_max_error", {{"n", 1}, {"mean", 0.1}, {"std", 0.0}, {"worst", 0.1}}}}}};
+  s["methods"]["setmembership"] = {{"applicable", false}, {"reason", "a |reason| with bars"}};
+  const std::string md = SummaryMarkdown(s);
+  EXPECT_TRUE(Has(md, "normalised \\|G\\| max error")) << md;
+  ExpectWellFormedTables(md);
+}
+
+TEST(ReadableOutputs, PlotLabelsAndTheMidpointCurveAreExplained) {
+  const auto d = Fresh("outputs_plots");
+  const auto scenario = compare::LoadScenario("setmembership-example");
+  nlohmann::json run = {{"run", 0}, {"methods", nlohmann::json::object()}};
+  run["methods"]["setmembership"] = {
+      {"applicable", true},
+      {"curves", {{"static_u", {-1.0, 0.0, 1.0}}, {"static_y", {0.0, 0.0, 0.0}}, {"omega", {0.1, 1.0}}, {"gain", {1.0, 1.0}}}},
+      {"quantities", {{"static_rms_pct", 50.0}}}};
+  nlohmann::json summary = {{"methods", nlohmann::json::object()}};
+  summary["methods"]["setmembership"] = {
+      {"applicable", true}, {"runs_ok", 1}, {"failures", nlohmann::json::array()},
+      {"quantities", {{"static_rms_pct", {{"n", 1}, {"mean", 50.0}, {"std", 0.0}, {"worst", 50.0}}}}}};
+  compare::WritePlots(d.string(), scenario, {run}, summary);
+  std::ifstream in(d / "plots" / "plots.gp");
+  std::stringstream gp;
+  gp << in.rdbuf();
+  EXPECT_TRUE(Has(gp.str(), "y_{ss}")) << gp.str();
+  EXPECT_FALSE(Has(gp.str(), "y_ss")) << gp.str();
+  EXPECT_TRUE(Has(gp.str(), "interval centres")) << gp.str();
+  EXPECT_TRUE(Has(compare::SummaryMarkdown(summary), "centres of its guaranteed intervals"));
+}
+
 }  // namespace
 }  // namespace hw
