@@ -78,5 +78,24 @@ TEST(BrouriOutliers, PeriodicAverageLeavesOutTheSpike) {
   EXPECT_TRUE(clean.outliers.empty());
 }
 
+TEST(BrouriOutliers, CleanNoisyRecordingsFlagNothing) {
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    const auto run = PaperSteps(seed);
+    const auto holds = AverageHolds(run.y, run.plan.Levels(), run.plan.hold_samples, run.plan.average_samples);
+    for (std::size_t j = 0; j < holds.size(); ++j) EXPECT_TRUE(holds[j].outliers.empty()) << "seed " << seed << " hold " << j;
+  }
+  const auto sys = BacklashHwSystem::PaperExample();
+  Summary s;
+  const auto est = Estimate(PaperSteps(1), &s);
+  ASSERT_TRUE(s.ok) << s.message;
+  const auto plan = MakeSinePlan(est, {0.02, 0.1}, 1.0, 128, 10, 80.0);
+  for (std::uint64_t seed = 1; seed <= 10; ++seed)
+    for (std::size_t i = 0; i < plan.experiments.size(); ++i) {
+      const auto y = Simulate(sys, plan.Input(i), plan.experiments[i].sample_time(), seed).y;
+      Summary d;
+      EXPECT_TRUE(EstimateFromSine(plan, i, {}, {}, y, &d).outliers.empty()) << "seed " << seed << " sine " << i;
+    }
+}
+
 }  // namespace
 }  // namespace hw::brouri

@@ -24,6 +24,9 @@ double RobustSigma(const std::vector<double>& v) {
 std::vector<std::size_t> IsolatedOutliers(const std::vector<double>& y, std::size_t first, std::size_t end,
                                           double median, double threshold) {
   constexpr std::size_t kMaxRun = 2;
+  // The samples around a run must lie well inside the threshold: a smooth transient that hovers near the
+  // threshold while noise carries single samples across it is no outlier.
+  auto calm = [&](std::size_t k) { return std::abs(y[k] - median) <= 0.5 * threshold; };
   std::vector<std::size_t> out;
   for (std::size_t i = first; i < end;) {
     if (!(std::abs(y[i] - median) > threshold)) {
@@ -32,7 +35,7 @@ std::vector<std::size_t> IsolatedOutliers(const std::vector<double>& y, std::siz
     }
     std::size_t j = i;
     while (j < end && std::abs(y[j] - median) > threshold) ++j;
-    if (i > first && j - i <= kMaxRun)
+    if (i > first && j - i <= kMaxRun && calm(i - 1) && (j == end || calm(j)))
       for (std::size_t k = i; k < j; ++k) out.push_back(k);
     i = j;
   }

@@ -17,8 +17,8 @@ double Median(std::vector<double> v);
 double RobustSigma(const std::vector<double>& v);  // 1.4826 * median |v - median(v)|
 
 // Indices i in [first, end) of isolated outliers of y around `median`: runs of at most two consecutive samples
-// beyond `threshold` with a sample within it before them in the same range (a run that starts the range is
-// a transient after a level change, not an outlier).
+// beyond `threshold` whose neighbours lie within half of it, the one before them in the same range (a run
+// that starts the range is a transient after a level change, not an outlier).
 std::vector<std::size_t> IsolatedOutliers(const std::vector<double>& y, std::size_t first, std::size_t end,
                                           double median, double threshold);
 
