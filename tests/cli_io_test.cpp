@@ -127,7 +127,10 @@ TEST_F(CliIo, FailingEsmaeilaniWritesNoModel) {
   t.add_column("y", y);
   write_csv(Path("seg.csv"), t);
   std::ofstream(Path("bad.csv")) << "u,y\n1,2\n3,oops\n";
-  const std::string common = "esmaeilani --order 1 --grid-f 6 --grid-g 6 --data " + Path("seg.csv") + " --out " + Path("m.json");
+  // f pinned at two points, g^-1 with a positive slope: the normalisation the estimator requires.
+  std::ofstream(Path("c.json")) << R"({"f": {"points": [[0, 0], [0.9, 1.0458]]}, "g_inverse": {"slopes": [{"min": 0.2}]}})";
+  const std::string common = "esmaeilani --order 1 --grid-f 6 --grid-g 6 --data " + Path("seg.csv") + " --constraints " +
+                             Path("c.json") + " --out " + Path("m.json");
   const auto good = Cli(common + " --validate " + Path("seg.csv"));
   ASSERT_EQ(good.code, 0) << good.output;
   ASSERT_TRUE(fs::exists(Path("m.json")));

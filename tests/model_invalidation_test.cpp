@@ -13,6 +13,8 @@
 #include <random>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
 
