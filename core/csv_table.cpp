@@ -91,7 +91,8 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
       if (c < cells.size() && !cells[c].empty()) {
         char* end = nullptr;
         v = std::strtod(cells[c].c_str(), &end);
-        if (end == cells[c].c_str() || *end != '\0')
+        // Decimal numbers only: strtod would also read hexadecimal ("0x10" as 16).
+        if (end == cells[c].c_str() || *end != '\0' || cells[c].find_first_of("xXpP") != std::string::npos)
           throw InputError(fmt::format("{}:{}: column '{}' holds '{}', which is not a number", source,
                                        line_no, table.names[c], cells[c]));
       }
