@@ -237,18 +237,16 @@ void HwOuterSet::CheckBasisValues() {
       ++lost_noise;
     }
   }
-  if (Spread(in_max) > kResolvedSpread)
+  auto warn_spread = [&](const std::vector<double>& magnitudes, const char* side, double max_abs, const char* column) {
+    if (Spread(magnitudes) <= kResolvedSpread) return;
     warnings_.push_back(fmt::format(
-        "the input basis values span {:.1e} (max |u| = {:g}): the smallest terms lose all relative precision in "
-        "the solvers (about 8 digits); scale u to max |u| of about 1 (divide column u by {:g}; the parameters and "
+        "the {} basis values span {:.1e} (max |{}| = {:g}): the smallest terms lose all relative precision in the "
+        "solvers (about 8 digits); scale {} to max |{}| of about 1 (divide column {} by {:g}; the parameters and "
         "the prior box scale with it)",
-        Spread(in_max), u_max, PowerOfTen(u_max)));
-  if (Spread(out_max) > kResolvedSpread)
-    warnings_.push_back(fmt::format(
-        "the output basis values span {:.1e} (max |y| = {:g}): the smallest terms lose all relative precision in "
-        "the solvers (about 8 digits); scale y to max |y| of about 1 (divide column y and the noise bound by {:g}; "
-        "the parameters and the prior box scale with it)",
-        Spread(out_max), y_max, PowerOfTen(y_max)));
+        side, Spread(magnitudes), column, max_abs, column, column, column, PowerOfTen(max_abs)));
+  };
+  warn_spread(in_max, "input", u_max, "u");
+  warn_spread(out_max, "output", y_max, "y");
   if (lost_noise > 0)
     warnings_.push_back(fmt::format(
         "at {} samples (first {}) the noise bound is below the resolution of y (y +- noise == y in double "

@@ -14,6 +14,7 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
+#include "tests/test_support.hpp"
 
 #ifdef HW_CLI_PATH
 namespace hw {
@@ -21,26 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
-  int code = -1;
-  std::string output;  // stdout and stderr
-  double seconds = 0;
-};
-
-Run Cli(const std::string& args) {
-  const auto t0 = std::chrono::steady_clock::now();
-  Run r;
-  FILE* p = ::popen((std::string(HW_CLI_PATH) + " " + args + " 2>&1").c_str(), "r");
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
-}
-
-bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing_support::Has;
+using Run = testing_support::CliRun;
+Run Cli(const std::string& args) { return testing_support::RunCli(args); }
 
 class CliIo : public ::testing::Test {
  protected:

@@ -9,22 +9,13 @@
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
 #include "relax/hw_outer_set.hpp"
+#include "tests/test_support.hpp"
 
 namespace hw {
 namespace {
 
-template <class F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no error thrown";
-  return "";
-}
-
-bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing_support::ErrorOf;
+using testing_support::Has;
 
 // A small recording of the paper's example with data rows on file lines 2.. (a header on line 1).
 relax::HwData Recording(int samples) {

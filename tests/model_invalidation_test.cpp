@@ -17,6 +17,7 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
+#include "tests/test_support.hpp"
 
 #ifdef HW_CLI_PATH
 namespace hw {
@@ -24,16 +25,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int Cli(const std::string& args, std::string* output) {
-  FILE* p = ::popen((std::string(HW_CLI_PATH) + " " + args + " 2>&1").c_str(), "r");
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) output->append(buf, n);
-  const int status = ::pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using testing_support::Has;
 
-bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+int Cli(const std::string& args, std::string* output) {
+  const auto r = testing_support::RunCli(args);
+  *output += r.output;
+  return r.code;
+}
 
 fs::path Dir() {
   const fs::path d = fs::path(::testing::TempDir()) / "model_invalidation";

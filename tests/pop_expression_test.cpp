@@ -7,25 +7,15 @@
 #include "core/csv_table.hpp"
 #include "core/polynomial.hpp"
 #include "relax/pop_json.hpp"
+#include "tests/test_support.hpp"
 
 namespace hw {
 namespace {
 
 using nlohmann::json;
 
-// The message of the InputError (or parse error) `f` throws; fails the test when it throws none.
-template <class F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no error thrown";
-  return "";
-}
-
-bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing_support::ErrorOf;
+using testing_support::Has;
 
 TEST(PolynomialParser, FractionalExponentIsAnErrorAtItsPosition) {
   const std::vector<std::string> names = {"x1"};
