@@ -1,5 +1,7 @@
 // `hwbounds bounds`: guaranteed parameter intervals of a Hammerstein–Wiener model from a recording.
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -7,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "core/recording.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
@@ -58,36 +61,230 @@ std::vector<double> parse_list(const std::string& text, const std::string& what)
   return v;
 }
 
+// Exit status of a run whose data prove that no parameter in the prior box fits (README, `bounds --help`).
+constexpr int kExitInvalidated = 3;
+
+// True when every sign orthant is proven empty by a certificate: D^ss(n) within the prior box is empty, so
+// no parameter in the box explains the data within the noise bound.
+// (To be replaced by BoundsSummary::invalidated() when the engine provides it.)
+bool ModelInvalidated(const relax::BoundsSummary& s) { return s.orthants_total > 0 && s.orthants_empty == s.orthants_total; }
+
+struct BoundsCliOptions {
+  std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
+  std::string solver = "sdpa", json_out, run_dir, truth, executor = "fork";
+  std::vector<std::string> box, params;
+  double noise_bound = 0.0;
+  int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
+  bool proper = false, no_cheap = false, quiet = false, verify = false, no_verify = false;
+  int contraction_passes = 0;
+};
+
+relax::HwData ReadData(const BoundsCliOptions& o) {
+  std::vector<std::string> columns = {o.u_col, o.y_col};
+  if (!o.noise_col.empty()) columns.push_back(o.noise_col);
+  const CsvTable table = read_recording(o.data, columns);
+  relax::HwData data;
+  data.source = o.data;
+  data.lines = table.lines;
+  data.u = table.column(o.u_col);
+  data.y = table.column(o.y_col);
+  if (!o.noise_col.empty()) {
+    data.noise_bound = table.column(o.noise_col);
+  } else {
+    if (!(o.noise_bound > 0)) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
+    data.noise_bound.assign(data.y.size(), o.noise_bound);
+  }
+  return data;
+}
+
+relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
+  relax::HwStructure structure;
+  structure.input_basis = relax::parse_basis(o.input_basis);
+  structure.output_basis = relax::parse_basis(o.output_basis);
+  structure.na = o.na;
+  structure.nb = o.nb;
+  structure.strictly_proper = !o.proper;
+  std::string error;
+  if (!structure.IsValid(&error)) throw InputError(error);
+  return structure;
+}
+
+relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
+  const int minimal_order = std::max(1, (o.horizon + 2) / 2);
+  if (o.order > 0 && o.order < minimal_order)
+    throw InputError(fmt::format("--order {} is below the minimal order ceil((n+1)/2) = {} of horizon {}", o.order,
+                                 minimal_order, o.horizon));
+  relax::BoundsOptions options;
+  options.order = o.order > 0 ? o.order : minimal_order;
+  options.solver = o.solver;
+  options.threads = o.threads;
+  options.executor = sdp::MakeExecutor(o.executor, o.threads);
+  options.run_dir = o.run_dir;
+  options.cheap_pass = !o.no_cheap;
+  options.contraction_passes = o.contraction_passes;
+  options.parameters = o.params;
+  options.generation.verify.enabled = !o.no_verify;
+  if (!o.quiet)  // one line per constraint-generation round, printed by the process that runs the job
+    options.round_log = [](const std::string& line) { fmt::print(stderr, "  {}\n", line); };
+  return options;
+}
+
+// The interval table; returns whether every given true value lies inside its interval.
+bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::string>& names,
+                    const std::vector<double>& truth) {
+  fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {:<10} {:>19}  {}\n", "parameter", "lower", "upper", "half-width",
+             "verified", "correction lo/up", "status");
+  bool covered = true;
+  for (const auto& iv : summary.intervals) {
+    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
+    std::string status = iv.lower.status == "guaranteed" && iv.upper.status == "guaranteed"
+                             ? "guaranteed"
+                             : fmt::format("lower {}, upper {}", iv.lower.status, iv.upper.status);
+    if (!truth.empty()) {
+      const bool in = iv.lower.value <= truth[k] && truth[k] <= iv.upper.value;
+      covered = covered && in;
+      status += fmt::format("  truth {:.6g} {}", truth[k], in ? "inside" : "OUTSIDE");
+    }
+    const std::string verified = iv.lower.verification == iv.upper.verification
+                                     ? iv.lower.verification
+                                     : iv.lower.verification + "/" + iv.upper.verification;
+    fmt::print("{:<10} {:>12.6f} {:>12.6f} {:>11.6f}  {:<10} {:>9.1e}/{:<9.1e}  {}\n", iv.name, iv.lower.value,
+               iv.upper.value, iv.half_width(), verified, iv.lower.correction, iv.upper.correction, status);
+    for (const auto* ep : {&iv.lower, &iv.upper})
+      if (!ep->note.empty()) fmt::print("           note: {}\n", ep->note);
+  }
+  return covered;
+}
+
+// The verdict of an empty feasible set: what it means, which certificates prove it, where to look next.
+void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptions& o) {
+  fmt::print("\nVERDICT: model invalidated. No parameter in the prior box explains the data within the noise bound: "
+             "the model class (na = {}, nb = {}, input basis {}, output basis {}, horizon {}) or the noise bound is "
+             "wrong.\n",
+             o.na, o.nb, o.input_basis, o.output_basis, o.horizon);
+  std::map<std::string, int> by_certificate;
+  for (const auto& r : summary.orthants) ++by_certificate[r.status];
+  fmt::print("certificates: all {} sign orthants are proven empty ({}), each {}:\n", summary.orthants_total,
+             [&] {
+               std::string c;
+               for (const auto& [kind, n] : by_certificate) c += fmt::format("{}{} {}", c.empty() ? "" : ", ", n, kind);
+               return c;
+             }(),
+             o.no_verify ? "by the solver's floating-point certificate (--no-verify)"
+                         : "by a certificate verified in interval arithmetic");
+  for (const auto& r : summary.orthants) fmt::print("  orthant {:>3} ({}): {}\n", r.index, r.signs, r.status);
+  fmt::print("next: `hwbounds diagnose --data REC --validate REC2 --fit hw:NA,NB,PIN,POUT` looks for what the model "
+             "leaves out (docs/diagnose.md); a larger noise bound, other bases or orders, or a wider --box change the "
+             "question.\n");
+}
+
+void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std::string>& names, bool verify) {
+  fmt::print("\nprior box (assumption): ");
+  for (std::size_t i = 0; i < names.size(); ++i)
+    fmt::print("{}{} in [{}, {}]", i ? ", " : "", names[i], summary.box[i].first, summary.box[i].second);
+  for (const auto& [l, b] : summary.orthant_boxes) {
+    fmt::print("\ncontracted box of orthant {} (proven to hold its points of D^ss(n) in the prior box): ", l);
+    for (std::size_t i = 0; i < names.size(); ++i)
+      fmt::print("{}{} in [{:.6g}, {:.6g}]", i ? ", " : "", names[i], b[i].first, b[i].second);
+  }
+  fmt::print("\northants: {} total, {} proven empty, {} solved, {} failed; {} relaxation jobs ({} SDP solves, "
+             "{} from cache), largest SDP {} moments / {} blocks, median solve {:.2f} s, wall {:.1f} s\n",
+             summary.orthants_total, summary.orthants_empty, summary.orthants_solved, summary.orthants_failed,
+             summary.sdp_jobs, summary.sdp_solves, summary.jobs_from_cache, summary.largest_moments,
+             summary.largest_blocks, summary.median_solve_seconds, summary.wall_seconds);
+  for (const auto& r : summary.row_reduction) {
+    std::string steps;
+    for (const auto& c : r.at("per_step"))
+      if (c.contains("step"))
+        steps += fmt::format("{}step {}: {} of {}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
+                             c.at("kept").get<int>(), c.at("rows").get<int>());
+    fmt::print("exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);
+  }
+  if (!summary.bound_sources.empty()) {
+    std::string sources;
+    for (const auto& [what, count] : summary.bound_sources)
+      sources += fmt::format("{}{} {}", sources.empty() ? "" : ", ", count, what);
+    fmt::print("orthant bounds entering the endpoints: {}\n", sources);
+  }
+  if (summary.clipped_to_box) fmt::print("note: endpoints beyond the prior box are intersected with it\n");
+  if (verify)
+    fmt::print("verification: {:.2f} s for {:.2f} s of SDP solves ({:.1f}%)\n", summary.verify_seconds,
+               summary.solve_seconds,
+               summary.solve_seconds > 0 ? 100 * summary.verify_seconds / summary.solve_seconds : 0.0);
+}
+
+void PrintWarnings(const relax::BoundsSummary& summary, bool verify) {
+  if (!summary.all_guaranteed())
+    fmt::print("WARNING: some endpoints are conservative fallbacks (still valid bounds) or floating-point bounds that "
+               "verification could not prove (see notes and the verified column).\n");
+  if (!verify) return;
+  for (const auto& iv : summary.intervals)
+    for (const auto* ep : {&iv.lower, &iv.upper})
+      if (ep->verification == "unverified") {
+        fmt::print("WARNING: {} has an endpoint that rests on an unverified floating-point bound (see notes).\n",
+                   iv.name);
+        break;
+      }
+}
+
+// The result JSON; an invalidated model has "invalidated": true and null interval values.
+nlohmann::json ResultJson(const relax::BoundsSummary& summary, const BoundsCliOptions& o, const relax::HwOuterSet& set,
+                          const std::vector<double>& truth, bool covered) {
+  auto j = summary.to_json();
+  const bool invalidated = ModelInvalidated(summary);
+  j["invalidated"] = invalidated;
+  if (invalidated) {
+    j["verdict"] = "no parameter in the prior box explains the data within the noise bound: the model class or the "
+                   "noise bound is wrong";
+    for (auto& iv : j["intervals"]) {
+      iv["half_width"] = nullptr;
+      for (const char* side : {"lower", "upper"}) iv[side]["value"] = nullptr;
+    }
+  }
+  j["data"] = o.data;
+  j["data_warnings"] = set.warnings();
+  j["structure"] = {{"na", o.na}, {"nb", o.nb}, {"proper", o.proper}, {"input_basis", o.input_basis},
+                    {"output_basis", o.output_basis}};
+  if (!truth.empty() && !invalidated) {
+    j["truth"] = truth;
+    j["truth_covered"] = covered;
+  }
+  return j;
+}
+
 }  // namespace
 
 void AddBoundsCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("bounds", "Guaranteed parameter intervals (set-membership, paper 001) from a recording");
-  struct Opts {
-    std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
-    std::string solver = "sdpa", json_out, run_dir, truth, executor = "fork";
-    std::vector<std::string> box, params;
-    double noise_bound = 0.0;
-    int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
-    bool proper = false, no_cheap = false, quiet = false, verify = true;
-    int contraction_passes = 0;
-  };
-  auto o = std::make_shared<Opts>();
+  cmd->footer(fmt::format(
+      "Exit status: 0 intervals computed; {} model invalidated (every sign orthant proven empty: no parameter in the "
+      "prior box explains the data within the noise bound; the JSON has \"invalidated\": true and null intervals); "
+      "2 bad input; 1 other failure.",
+      kExitInvalidated));
+  auto o = std::make_shared<BoundsCliOptions>();
   cmd->add_option("--data", o->data, "recording: CSV with a header, or FILE.mat:u=VAR,y=VAR (docs/recordings.md)")
       ->required();
   cmd->add_option("--u-col", o->u_col, "input column");
   cmd->add_option("--y-col", o->y_col, "output column");
-  cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value");
-  cmd->add_option("--noise-col", o->noise_col, "column with a per-sample noise bound (instead of --noise-bound)");
-  cmd->add_option("--na", o->na, "denominator order");
-  cmd->add_option("--nb", o->nb, "numerator order (b_0..b_nb, b_0 = 0 unless --proper)");
+  auto* noise_bound = cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value")
+                          ->check(CLI::PositiveNumber)
+                          ->default_str("");
+  auto* noise_col =
+      cmd->add_option("--noise-col", o->noise_col, "column with a per-sample noise bound (instead of --noise-bound)");
+  noise_bound->excludes(noise_col);
+  cmd->add_option("--na", o->na, "denominator order")->check(CLI::Range(1, 20));
+  cmd->add_option("--nb", o->nb, "numerator order (b_0..b_nb, b_0 = 0 unless --proper)")->check(CLI::Range(0, 20));
   cmd->add_flag("--proper", o->proper, "estimate b_0 too (proper, not strictly proper)");
   cmd->add_option("--input-basis", o->input_basis, "psi basis: poly:K or a list like 'w,w^3,tanh'");
   cmd->add_option("--output-basis", o->output_basis, "phi basis of the inverse output map");
-  cmd->add_option("--horizon", o->horizon, "dynamic horizon n");
-  cmd->add_option("--order", o->order, "relaxation order delta (default: minimal order ceil((n+1)/2))");
-  cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI (default -10,10)");
+  cmd->add_option("--horizon", o->horizon, "dynamic horizon n")->check(CLI::Range(1, 20));
+  cmd->add_option("--order", o->order, "relaxation order delta, at least the minimal order ceil((n+1)/2)")
+      ->check(CLI::Range(1, 20))
+      ->default_str("minimal");
+  cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
   cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
-  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; default: all cores)");
+  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)")
+      ->check(CLI::Range(0, 4096));
   cmd->add_option("--executor", o->executor,
                   "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "
                   "coordinates, the other ranks solve)")
@@ -97,51 +294,24 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--contract-passes", o->contraction_passes,
                   "cheap passes repeated in each orthant's contracted box (0 = no box contraction)")
       ->check(CLI::Range(0, 10));
-  cmd->add_flag("--verify,!--no-verify", o->verify,
-                "verify every bound and emptiness certificate rigorously (interval arithmetic; default on)");
-  cmd->add_option("--params", o->params, "only these intervals (names such as a1 b1; default: all)")->delimiter(',');
+  auto* verify = cmd->add_flag("--verify", o->verify,
+                               "verify every bound and emptiness certificate rigorously in interval arithmetic "
+                               "(the default)");
+  cmd->add_flag("--no-verify", o->no_verify, "skip the verification: endpoints are the solvers' floating-point bounds")
+      ->excludes(verify);
+  cmd->add_option("--params", o->params, "only these intervals (names such as a1 b1)")->delimiter(',')->default_str("all");
   cmd->add_option("--truth", o->truth, "comma list of true parameters, to report coverage (simulation studies)");
   cmd->add_option("--json", o->json_out, "write the result as JSON");
   cmd->add_flag("--quiet", o->quiet, "no progress lines");
   cmd->callback([o] {
-    std::vector<std::string> columns = {o->u_col, o->y_col};
-    if (!o->noise_col.empty()) columns.push_back(o->noise_col);
-    const CsvTable table = read_recording(o->data, columns);
-    relax::HwData data;
-    data.source = o->data;
-    data.u = table.column(o->u_col);
-    data.y = table.column(o->y_col);
-    if (!o->noise_col.empty()) {
-      data.noise_bound = table.column(o->noise_col);
-    } else {
-      if (!(o->noise_bound > 0))
-        throw InputError(fmt::format("--noise-bound must be a positive number (got {}), or give --noise-col",
-                                     o->noise_bound));
-      data.noise_bound.assign(data.y.size(), o->noise_bound);
-    }
-    relax::HwStructure structure;
-    structure.input_basis = relax::parse_basis(o->input_basis);
-    structure.output_basis = relax::parse_basis(o->output_basis);
-    structure.na = o->na;
-    structure.nb = o->nb;
-    structure.strictly_proper = !o->proper;
-    std::string error;
-    if (!structure.IsValid(&error)) throw InputError(error);
+    if (!o->json_out.empty()) CheckOutputFile(o->json_out, "--json");
+    if (!o->run_dir.empty()) CheckOutputDirectory(o->run_dir, "--run-dir");
+    const relax::HwData data = ReadData(*o);
+    const relax::HwStructure structure = ReadStructure(*o);
     const auto names = relax::MakeLayout(structure).names;
-    relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
-
-    relax::BoundsOptions options;
-    options.order = o->order > 0 ? o->order : std::max(1, (o->horizon + 2) / 2);
-    options.solver = o->solver;
-    options.threads = o->threads;
-    options.executor = sdp::MakeExecutor(o->executor, o->threads);
-    options.run_dir = o->run_dir;
-    options.cheap_pass = !o->no_cheap;
-    options.contraction_passes = o->contraction_passes;
-    options.parameters = o->params;
-    options.generation.verify.enabled = o->verify;
-    if (!o->quiet)  // one line per constraint-generation round, printed by the process that runs the job
-      options.round_log = [](const std::string& line) { fmt::print(stderr, "  {}\n", line); };
+    const relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
+    for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
+    const relax::BoundsOptions options = MakeBoundsOptions(*o);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
       relax::ComputeBounds(options, set);
       return;
@@ -170,81 +340,17 @@ void AddBoundsCommand(CLI::App& app) {
                  p.elapsed_seconds, p.eta_seconds);
     };
     const auto summary = relax::ComputeBounds(options, set, progress);
-    fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {:<10} {:>19}  {}\n", "parameter", "lower", "upper", "half-width",
-               "verified", "correction lo/up", "status");
+    const bool invalidated = ModelInvalidated(summary);
     bool covered = true;
-    for (const auto& iv : summary.intervals) {
-      const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
-      std::string status = iv.lower.status == "guaranteed" && iv.upper.status == "guaranteed"
-                               ? "guaranteed"
-                               : fmt::format("lower {}, upper {}", iv.lower.status, iv.upper.status);
-      if (!truth.empty()) {
-        const bool in = iv.lower.value <= truth[k] && truth[k] <= iv.upper.value;
-        covered = covered && in;
-        status += fmt::format("  truth {:.6g} {}", truth[k], in ? "inside" : "OUTSIDE");
-      }
-      const std::string verified = iv.lower.verification == iv.upper.verification
-                                       ? iv.lower.verification
-                                       : iv.lower.verification + "/" + iv.upper.verification;
-      fmt::print("{:<10} {:>12.6f} {:>12.6f} {:>11.6f}  {:<10} {:>9.1e}/{:<9.1e}  {}\n", iv.name, iv.lower.value,
-                 iv.upper.value, iv.half_width(), verified, iv.lower.correction, iv.upper.correction, status);
-      for (const auto* ep : {&iv.lower, &iv.upper})
-        if (!ep->note.empty()) fmt::print("           note: {}\n", ep->note);
-    }
-    fmt::print("\nprior box (assumption): ");
-    for (std::size_t i = 0; i < names.size(); ++i)
-      fmt::print("{}{} in [{}, {}]", i ? ", " : "", names[i], summary.box[i].first, summary.box[i].second);
-    for (const auto& [l, b] : summary.orthant_boxes) {
-      fmt::print("\ncontracted box of orthant {} (proven to hold its points of D^ss(n) in the prior box): ", l);
-      for (std::size_t i = 0; i < names.size(); ++i)
-        fmt::print("{}{} in [{:.6g}, {:.6g}]", i ? ", " : "", names[i], b[i].first, b[i].second);
-    }
-    fmt::print("\northants: {} total, {} proven empty, {} solved, {} failed; {} relaxation jobs ({} SDP solves, "
-               "{} from cache), largest SDP {} moments / {} blocks, median solve {:.2f} s, wall {:.1f} s\n",
-               summary.orthants_total, summary.orthants_empty, summary.orthants_solved, summary.orthants_failed,
-               summary.sdp_jobs, summary.sdp_solves, summary.jobs_from_cache, summary.largest_moments,
-               summary.largest_blocks, summary.median_solve_seconds, summary.wall_seconds);
-    for (const auto& r : summary.row_reduction) {
-      std::string steps;
-      for (const auto& c : r.at("per_step"))
-        if (c.contains("step"))
-          steps += fmt::format("{}step {}: {} of {}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
-                               c.at("kept").get<int>(), c.at("rows").get<int>());
-      fmt::print("exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);
-    }
-    if (!summary.bound_sources.empty()) {
-      std::string sources;
-      for (const auto& [what, count] : summary.bound_sources)
-        sources += fmt::format("{}{} {}", sources.empty() ? "" : ", ", count, what);
-      fmt::print("orthant bounds entering the endpoints: {}\n", sources);
-    }
-    if (summary.clipped_to_box) fmt::print("note: endpoints beyond the prior box are intersected with it\n");
-    if (!summary.all_guaranteed())
-      fmt::print("WARNING: some endpoints are conservative fallbacks (still valid bounds) or floating-point bounds that "
-                 "verification could not prove (see notes and the verified column).\n");
-    if (o->verify) {
-      fmt::print("verification: {:.2f} s for {:.2f} s of SDP solves ({:.1f}%)\n", summary.verify_seconds,
-                 summary.solve_seconds, summary.solve_seconds > 0 ? 100 * summary.verify_seconds / summary.solve_seconds : 0.0);
-      for (const auto& iv : summary.intervals)
-        for (const auto* ep : {&iv.lower, &iv.upper})
-          if (ep->verification == "unverified") {
-            fmt::print("WARNING: {} has an endpoint that rests on an unverified floating-point bound (see notes).\n",
-                       iv.name);
-            break;
-          }
-    }
+    if (invalidated) PrintInvalidation(summary, *o);
+    else covered = PrintIntervals(summary, names, truth);
+    PrintRunSummary(summary, names, !o->no_verify);
+    if (!invalidated) PrintWarnings(summary, !o->no_verify);
     if (!o->json_out.empty()) {
-      auto j = summary.to_json();
-      j["data"] = o->data;
-      j["structure"] = {{"na", o->na}, {"nb", o->nb}, {"proper", o->proper}, {"input_basis", o->input_basis},
-                        {"output_basis", o->output_basis}};
-      if (!truth.empty()) {
-        j["truth"] = truth;
-        j["truth_covered"] = covered;
-      }
-      write_text_atomic(o->json_out, j.dump(2) + "\n");
+      write_text_atomic(o->json_out, ResultJson(summary, *o, set, truth, covered).dump(2) + "\n");
       fmt::print("wrote {}\n", o->json_out);
     }
+    if (invalidated) throw CommandExit{kExitInvalidated};
   });
 }
 

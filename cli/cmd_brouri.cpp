@@ -13,6 +13,8 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
+#include "core/output_files.hpp"
 #include "estimators/brouri/experiment.hpp"
 
 namespace hw::cli {
@@ -20,18 +22,33 @@ namespace {
 namespace fs = std::filesystem;
 using namespace hw::brouri;
 
-nlohmann::json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+nlohmann::json ReadJson(const std::string& path) { return ReadJsonFile(path, "JSON file"); }
+
+// Runs a reader of JSON contents, prefixing its errors with the file they came from.
+template <class Read>
+auto FromFile(const std::string& path, Read&& read) {
   try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
+    return read();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()));
   }
 }
 
+// The stage-1 estimate from a `brouri estimate` result: the stage-1 file itself, or a stage-2 file's copy.
+NonlinearEstimate ReadNonlinearEstimate(const std::string& path) {
+  const auto j = ReadJson(path);
+  return FromFile(path, [&] {
+    if (j.is_object() && j.contains("nonlinear")) {
+      CheckKeys(j, {"stage", "points", "nonlinear", "note"}, "stage-2 result");
+      return NonlinearEstimate::from_json(j.at("nonlinear"));
+    }
+    return NonlinearEstimate::from_json(j, {"stage", "summary"});
+  });
+}
+
 std::string PlanStage(const nlohmann::json& j, const std::string& path) {
-  if (j.value("method", std::string()) != "brouri" || !j.contains("stage"))
+  if (!j.is_object() || !j.contains("method") || j.at("method") != "brouri" || !j.contains("stage") ||
+      !j.at("stage").is_string())
     throw InputError(fmt::format("{}: not a brouri plan (expected \"method\": \"brouri\" and a \"stage\"); write one "
                                  "with `hwbounds brouri plan steps|sines`",
                                  path));
@@ -61,8 +78,8 @@ void AddBrouriPlan(CLI::App& brouri) {
   auto* steps = plan->add_subcommand("steps", "Stage 1: reset hold, ascending holds, descending holds");
   steps->add_option("--levels-up", so->up, "ascending levels U_1 < ... < U_N (comma list)")->required()->delimiter(',');
   steps->add_option("--levels-down", so->down, "descending levels (comma list, decreasing)")->required()->delimiter(',');
-  steps->add_option("--reset", so->reset,
-                    "reset level applied first (below U_1; default: the lowest descending level)");
+  steps->add_option("--reset", so->reset, "reset level applied first (below U_1)")
+      ->default_str("the lowest descending level");
   steps->add_option("--sample-time", so->ts, "sample time Ts (s)")->check(CLI::PositiveNumber);
   steps->add_option("--settling-time", so->settling, "upper bound on the settling time of G (s): each hold waits this long")
       ->check(CLI::PositiveNumber);
@@ -70,6 +87,7 @@ void AddBrouriPlan(CLI::App& brouri) {
       ->check(CLI::Range(2, 100000000));
   steps->add_option("--out-dir", so->out_dir, "directory for plan.json and steps.csv")->required();
   steps->callback([so] {
+    CheckOutputDirectory(so->out_dir, "--out-dir");
     double reset = so->reset;
     if (std::isnan(reset)) {
       if (so->down.empty()) throw InputError("--levels-down is empty");
@@ -77,13 +95,15 @@ void AddBrouriPlan(CLI::App& brouri) {
                        so->up.empty() ? 0.0 : so->up.front() - 1.0);
     }
     const StepPlan p = MakeStepPlan(so->up, so->down, reset, so->ts, so->settling, so->m);
-    fs::create_directories(so->out_dir);
     const auto u = p.Input();
     CsvTable t;
     t.add_column("t", Times(u.size(), p.sample_time));
     t.add_column("u", u);
-    write_csv(so->out_dir + "/" + p.file, t, 15);
-    write_text_atomic(so->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    OutputFiles files;
+    files.Add(so->out_dir + "/" + p.file, format_csv(t, 15));
+    files.Add(so->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    fs::create_directories(so->out_dir);
+    files.Commit();
     fmt::print("stage-1 plan: {} holds of {} samples ({} s each, last M = {} averaged), {} samples = {:.6g} s in all\n",
                p.Levels().size(), p.hold_samples, p.hold_samples * p.sample_time, p.average_samples, u.size(),
                u.size() * p.sample_time);
@@ -110,12 +130,12 @@ void AddBrouriPlan(CLI::App& brouri) {
       ->check(CLI::NonNegativeNumber);
   sines->add_option("--out-dir", si->out_dir, "directory for plan.json and sine_<i>.csv")->required();
   sines->callback([si] {
-    const auto j = ReadJson(si->nonlinear);
-    const NonlinearEstimate est = NonlinearEstimate::from_json(j.contains("nonlinear") ? j.at("nonlinear") : j);
+    CheckOutputDirectory(si->out_dir, "--out-dir");
+    const NonlinearEstimate est = ReadNonlinearEstimate(si->nonlinear);
     std::vector<double> omegas = si->omegas;
     std::sort(omegas.begin(), omegas.end());
     const SinePlan p = MakeSinePlan(est, omegas, si->amplitude, si->spp, si->periods, si->settling);
-    fs::create_directories(si->out_dir);
+    OutputFiles files;
     for (std::size_t i = 0; i < p.experiments.size(); ++i) {
       const auto& e = p.experiments[i];
       CsvTable t;
@@ -123,11 +143,13 @@ void AddBrouriPlan(CLI::App& brouri) {
       t.add_column("t", Times(z.size(), e.sample_time()));
       t.add_column("z", z);
       t.add_column("u", p.Input(i));
-      write_csv(si->out_dir + "/" + e.file, t, 15);
+      files.Add(si->out_dir + "/" + e.file, format_csv(t, 15));
       fmt::print("  {}: omega = {} rad/s, Ts = {:.6g} s, {} transient + {} averaged periods = {:.6g} s\n", e.file,
                  e.omega, e.sample_time(), e.transient_periods, e.periods, e.total_samples() * e.sample_time());
     }
-    write_text_atomic(si->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    files.Add(si->out_dir + "/plan.json", p.to_json().dump(2) + "\n");
+    fs::create_directories(si->out_dir);
+    files.Commit();
     fmt::print("stage-2 plan ({} pre-compensator for the estimated {}): apply column u of each file, add column y,\n"
                "then run  hwbounds brouri estimate --plan {}/plan.json --out frequency.json\n",
                ToString(est.kind == OperatorKind::kBacklash ? OperatorKind::kBacklashInverse : OperatorKind::kBacklash),
@@ -145,7 +167,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
   auto o = std::make_shared<Opts>();
   auto* cmd = brouri.add_subcommand("estimate", "Estimate from recordings of a plan (stage 1 or 2, read from the plan)");
   cmd->add_option("--plan", o->plan, "plan.json written by `brouri plan`")->required();
-  cmd->add_option("--data", o->data, "directory of the recordings (default: the plan's directory)");
+  cmd->add_option("--data", o->data, "directory of the recordings")->default_str("the plan's directory");
   cmd->add_option("--y-col", o->y_col, "name of the measured-output column");
   cmd->add_option("--degree", o->degree, "stage 1: degree p of h (0 = select from the data)")->check(CLI::Range(0, 15));
   cmd->add_option("--max-degree", o->max_degree, "stage 1: largest degree the selection tries")->check(CLI::Range(1, 15));
@@ -159,13 +181,14 @@ void AddBrouriEstimate(CLI::App& brouri) {
   cmd->add_flag("--no-zoh-correction", o->no_zoh, "stage 2: do not correct for the hold (sinc gain, Ts/2 delay)");
   cmd->add_option("--out", o->out, "result JSON")->required();
   cmd->callback([o] {
+    CheckOutputFile(o->out, "--out");
     const auto j = ReadJson(o->plan);
     const auto stage = PlanStage(j, o->plan);
     const std::string dir = o->data.empty() ? fs::path(o->plan).parent_path().string() : o->data;
     auto path_of = [&](const std::string& file) { return (fs::path(dir.empty() ? "." : dir) / file).string(); };
     nlohmann::json result;
     if (stage == "steps") {
-      const StepPlan plan = StepPlan::from_json(j);
+      const StepPlan plan = FromFile(o->plan, [&] { return StepPlan::from_json(j); });
       NonlinearOptions opt;
       opt.degree = o->degree;
       opt.max_degree = o->max_degree;
@@ -191,7 +214,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
       fmt::print("h^(w) = {}\n", hs);
       result = StepsResultJson(est, s);
     } else {
-      const SinePlan plan = SinePlan::from_json(j);
+      const SinePlan plan = FromFile(o->plan, [&] { return SinePlan::from_json(j); });
       FrequencyOptions opt;
       opt.harmonic = o->harmonic;
       opt.zoh_correction = !o->no_zoh;
@@ -201,6 +224,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
         const auto rec = ReadRecording(path_of(e.file), e.sample_time(), o->y_col);
         Summary s;
         points.push_back(EstimateFromSine(plan, i, opt, rec.u, rec.y, &s));
+        if (!points.back().outliers.empty()) fmt::print("{}\n", s.message);
       }
       UnwrapPhases(&points);
       fmt::print("{:>10} {:>10} {:>12} {:>9} {:>9}\n", "omega", "|G^|", "phi^ (rad)", "harmonic", "misfit");
@@ -223,18 +247,21 @@ void AddBrouriSimulate(CLI::App& brouri) {
   auto o = std::make_shared<Opts>();
   auto* cmd = brouri.add_subcommand("simulate", "Record a plan on a simulated system (adds column y to the plan's CSVs)");
   cmd->add_option("--plan", o->plan, "plan.json")->required();
-  cmd->add_option("--system", o->system, "system JSON (default: the paper's Section 6 system; see docs/brouri.md)");
-  cmd->add_option("--noise-std", o->noise_std, "override the system's output noise standard deviation");
+  cmd->add_option("--system", o->system, "system JSON (see docs/brouri.md)")->default_str("the paper's Section 6 system");
+  cmd->add_option("--noise-std", o->noise_std, "override the system's output noise standard deviation")
+      ->default_str("the system's");
   cmd->add_option("--seed", o->seed, "noise seed");
-  cmd->add_option("--out-dir", o->out_dir, "directory for the recordings (default: the plan's directory)");
+  cmd->add_option("--out-dir", o->out_dir, "directory for the recordings")->default_str("the plan's directory");
   cmd->callback([o] {
     const auto j = ReadJson(o->plan);
     const auto stage = PlanStage(j, o->plan);
     BacklashHwSystem sys =
-        o->system.empty() ? BacklashHwSystem::PaperExample() : BacklashHwSystem::from_json(ReadJson(o->system));
+        o->system.empty() ? BacklashHwSystem::PaperExample()
+                          : FromFile(o->system, [&] { return BacklashHwSystem::from_json(ReadJson(o->system)); });
     if (!std::isnan(o->noise_std)) sys.noise_std = o->noise_std;
     const std::string dir = o->out_dir.empty() ? fs::path(o->plan).parent_path().string() : o->out_dir;
-    if (!dir.empty()) fs::create_directories(dir);
+    CheckOutputDirectory(dir.empty() ? "." : dir, "--out-dir");
+    OutputFiles files;
     auto write = [&](const std::string& file, double ts, const std::vector<double>& u, const std::vector<double>* z,
                      std::uint64_t seed) {
       CsvTable t;
@@ -242,20 +269,21 @@ void AddBrouriSimulate(CLI::App& brouri) {
       if (z) t.add_column("z", *z);
       t.add_column("u", u);
       t.add_column("y", Simulate(sys, u, ts, seed).y);
-      const auto path = (fs::path(dir.empty() ? "." : dir) / file).string();
-      write_csv(path, t, 15);
-      fmt::print("wrote {} ({} samples)\n", path, u.size());
+      files.Add((fs::path(dir.empty() ? "." : dir) / file).string(), format_csv(t, 15));
     };
     if (stage == "steps") {
-      const StepPlan p = StepPlan::from_json(j);
+      const StepPlan p = FromFile(o->plan, [&] { return StepPlan::from_json(j); });
       write(p.file, p.sample_time, p.Input(), nullptr, o->seed);
     } else {
-      const SinePlan p = SinePlan::from_json(j);
+      const SinePlan p = FromFile(o->plan, [&] { return SinePlan::from_json(j); });
       for (std::size_t i = 0; i < p.experiments.size(); ++i) {
         const auto z = p.Command(i);
         write(p.experiments[i].file, p.experiments[i].sample_time(), p.Input(i), &z, o->seed + 1000 + i);
       }
     }
+    if (!dir.empty()) fs::create_directories(dir);
+    files.Commit();
+    for (const auto& [path, text] : files.files()) fmt::print("wrote {}\n", path);
   });
 }
 

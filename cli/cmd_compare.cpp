@@ -5,6 +5,7 @@
 #include "cli/commands.hpp"
 #include "compare/study.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 
 namespace hw::cli {
 
@@ -31,19 +32,22 @@ void AddCompareCommand(CLI::App& app) {
   cmd->add_option("--runs", o->runs, "Monte Carlo runs R (run r uses seed S + r)");
   cmd->add_option("--seed", o->seed, "study seed S (also the seed of the common validation record)");
   cmd->add_option("--out", o->out, "output directory (a rerun with the same settings resumes)")->required();
-  cmd->add_option("--jobs", o->jobs, "worker processes (0 = one per core)");
-  cmd->add_option("--sm-samples", o->sm_samples, "override: set-membership record length N");
-  cmd->add_option("--horizon", o->horizon, "override: set-membership horizon n");
-  cmd->add_option("--order", o->order, "override: relaxation order delta");
-  cmd->add_option("--params", o->params, "override: only these intervals (no point estimate then)")->delimiter(',');
-  cmd->add_option("--box", o->box, "override: prior box half-width for every parameter");
-  cmd->add_option("--esm-samples", o->esm_samples, "override: Esmaeilani samples per operating record");
-  cmd->add_option("--esm-segments", o->esm_segments, "override: number of Esmaeilani operating records");
-  cmd->add_option("--val-samples", o->val_samples, "override: validation record length");
-  cmd->add_option("--periods", o->periods, "override: Brouri sine periods averaged (N of eq. 23)");
+  cmd->add_option("--jobs", o->jobs, "worker processes (0 = one per core)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--sm-samples", o->sm_samples, "override: set-membership record length N")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--horizon", o->horizon, "override: set-membership horizon n")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--order", o->order, "override: relaxation order delta")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--params", o->params, "override: only these intervals (no point estimate then)")
+      ->delimiter(',')
+      ->default_str("the scenario's");
+  cmd->add_option("--box", o->box, "override: prior box half-width for every parameter")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--esm-samples", o->esm_samples, "override: Esmaeilani samples per operating record")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--esm-segments", o->esm_segments, "override: number of Esmaeilani operating records")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--val-samples", o->val_samples, "override: validation record length")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--periods", o->periods, "override: Brouri sine periods averaged (N of eq. 23)")->check(CLI::PositiveNumber)->default_str("the scenario's");
   cmd->add_flag("--no-plots", o->no_plots, "skip gnuplot");
   cmd->add_flag("--quiet", o->quiet, "no per-run progress lines");
   cmd->callback([o] {
+    CheckOutputDirectory(o->out, "--out");
     compare::Scenario s = compare::LoadScenario(o->scenario);
     if (o->sm_samples > 0) s.setmembership.samples = o->sm_samples;
     if (o->horizon > 0) s.setmembership.horizon = o->horizon;

@@ -5,6 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
 #include "diagnose/diagnose.hpp"
 
@@ -29,15 +30,16 @@ void AddDiagnoseCommand(CLI::App& app) {
   cmd->add_option("--u-col", o->u_col, "input column");
   cmd->add_option("--y-col", o->y_col, "output column");
   cmd->add_option("--t-col", o->t_col, "time column (sample index when absent)");
-  cmd->add_option("--noise-std", o->o.noise_std, "output noise standard deviation (default: estimated)");
+  cmd->add_option("--noise-std", o->o.noise_std, "output noise standard deviation")->default_str("estimated");
   cmd->add_option("--init-samples", o->o.init_samples, "leading samples excluded from costs (transient from rest)");
   cmd->add_option("--holdout", o->o.holdout_fraction, "fraction of the identification recording held out for ranking");
   cmd->add_option("--min-improvement", o->o.min_improvement, "minimum penalised MSE reduction for a verdict");
   cmd->add_option("--significance-z", o->o.significance_z, "held-out paired z pre-screen");
   cmd->add_option("--validation-z", o->o.validation_z, "validation paired z required for a verdict");
-  cmd->add_option("--window", o->o.windows.length, "mismatch window length in samples (0 = auto)");
-  cmd->add_option("--effects", o->effects, "comma-separated candidates EFFECT@LOCATION (default: all)");
+  cmd->add_option("--window", o->o.windows.length, "mismatch window length in samples (0 = auto)")->default_str("auto");
+  cmd->add_option("--effects", o->effects, "comma-separated candidates EFFECT@LOCATION")->default_str("all");
   cmd->callback([o] {
+    CheckOutputDirectory(o->out, "--out");
     if (o->model.empty() == o->fit.empty()) throw InputError("diagnose needs exactly one of --model FILE or --fit SPEC");
     std::string err;
     if (!o->o.IsValid(&err)) throw InputError("diagnose: " + err);

@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
 #include "core/recording.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
@@ -63,8 +64,10 @@ void AddEsmaeilaniCommand(CLI::App& app) {
       s.name = path;
       return s;
     };
-    std::vector<esmaeilani::Segment> segs;
+    CheckOutputFile(o->out, "--out");
+    std::vector<esmaeilani::Segment> segs, validation;  // every input is read before any work
     for (const auto& p : o->data) segs.push_back(load(p));
+    for (const auto& p : o->validate) validation.push_back(load(p));
     esmaeilani::Constraints cons;
     if (!o->constraints.empty()) cons = esmaeilani::Constraints::Load(o->constraints);
     esmaeilani::Options opt;
@@ -101,19 +104,19 @@ void AddEsmaeilaniCommand(CLI::App& app) {
     for (std::size_t k = 0; k < m.y_grid.size(); ++k)
       fmt::print("  {:12.6g} {:12.6g}\n", m.y_grid[k], m.ginv_values[k]);
     const HwModel model = m.ToHwModel(opt.clamp_output);
-    write_text_atomic(o->out, esmaeilani::ModelFileJson(m, opt, cons, sum).dump(2) + "\n");
-    fmt::print("project model: a = [{:.6g}], b = [{:.6g}], delay {}; wrote {}\n", fmt::join(model.linear.a, ", "),
-               fmt::join(model.linear.b, ", "), model.linear.delay, o->out);
-    for (const auto& p : o->validate) {
-      const auto s = load(p);
-      const auto yh = m.Simulate(s.u, {}, opt.clamp_output);
+    const nlohmann::json j = esmaeilani::ModelFileJson(m, opt, cons, sum);
+    for (const auto& seg : validation) {
+      const auto yh = m.Simulate(seg.u, {}, opt.clamp_output);
       double maxe = 0.0;
-      for (std::size_t i = 0; i < yh.size(); ++i) maxe = std::max(maxe, std::abs(s.y[i] - yh[i]));
-      const auto [lo, hi] = std::minmax_element(s.y.begin(), s.y.end());
+      for (std::size_t i = 0; i < yh.size(); ++i) maxe = std::max(maxe, std::abs(seg.y[i] - yh[i]));
+      const auto [lo, hi] = std::minmax_element(seg.y.begin(), seg.y.end());
       fmt::print("validate {}: fit {:.2f} % (100(1-|y-yhat|/|y-mean y|)), RMSE {:.6g}, max error {:.6g} "
                  "({:.2f} % of the output range); simulated from the steady state at the first input\n",
-                 p, fit_percent(s.y, yh), rmse(s.y, yh), maxe, 100.0 * maxe / std::max(*hi - *lo, 1e-300));
+                 seg.name, fit_percent(seg.y, yh), rmse(seg.y, yh), maxe, 100.0 * maxe / std::max(*hi - *lo, 1e-300));
     }
+    write_text_atomic(o->out, j.dump(2) + "\n");
+    fmt::print("project model: a = [{:.6g}], b = [{:.6g}], delay {}; wrote {}\n", fmt::join(model.linear.a, ", "),
+               fmt::join(model.linear.b, ", "), model.linear.delay, o->out);
   });
 }
 

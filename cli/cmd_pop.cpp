@@ -3,11 +3,36 @@
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "relax/pop_json.hpp"
 #include "sdp/sdp_solver.hpp"
+#include "relax/relaxation_size.hpp"
 #include "sdp/sdpa_format.hpp"
 
 namespace hw::cli {
+namespace {
+
+// Refuses, with the numbers, a relaxation whose estimated memory exceeds what the machine has now; says the
+// size of a large one that fits before building it.
+void CheckRelaxationFits(const relax::PolyProblem& problem, int order) {
+  const auto size = relax::EstimateRelaxationSize(problem, order);
+  const double available = relax::AvailableMemoryBytes();
+  if (size.bytes > available) {
+    int fits = order;
+    while (fits > problem.minimal_order() && relax::EstimateRelaxationSize(problem, fits).bytes > available) --fits;
+    const auto largest = relax::EstimateRelaxationSize(problem, fits);
+    throw InputError(fmt::format(
+        "--order {}: the relaxation of this {}-variable problem is too large: {}, more than the {} of memory available; "
+        "{}",
+        order, problem.num_vars, size.describe(), relax::FormatBytes(available),
+        largest.bytes <= available
+            ? fmt::format("the largest order that fits is {} ({})", fits, relax::FormatBytes(largest.bytes))
+            : "even the minimal order does not fit"));
+  }
+  if (size.bytes > 1e8) fmt::print(stderr, "order {} relaxation: {}\n", order, size.describe());
+}
+
+}  // namespace
 
 void AddPopCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("pop", "Moment (Lasserre) relaxation of a polynomial optimisation problem (JSON)");
@@ -18,25 +43,30 @@ void AddPopCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("PROBLEM", o->problem, "problem JSON (see README: Polynomial problems)")->required();
-  cmd->add_option("--order", o->order, "relaxation order delta (default: minimal)");
+  cmd->add_option("--order", o->order, "relaxation order delta, at least the problem's minimal order")
+      ->check(CLI::Range(1, 1000000))
+      ->default_str("minimal");
   cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
   cmd->add_option("--export", o->export_path, "also write the SDP in SDPA sparse format (.dat-s)");
   cmd->add_flag("--json", o->json, "machine-readable output");
   cmd->callback([o] {
+    if (!o->export_path.empty()) CheckOutputFile(o->export_path, "--export");
     const auto problem = relax::LoadPolyProblem(o->problem);
     relax::RelaxationOptions options;
     options.order = o->order;
     relax::CheckRelaxationOrder(problem, o->order);
-    if (!o->export_path.empty()) {
-      const relax::MomentRelaxation relaxation(problem, o->order > 0 ? o->order : problem.minimal_order());
-      sdp::WriteSdpaSparse(o->export_path, relaxation.lmi());
-    }
+    CheckRelaxationFits(problem, o->order > 0 ? o->order : problem.minimal_order());
     auto solver = sdp::MakeSolver(o->solver);
     const auto r = relax::SolveRelaxation(options, problem, *solver);
+    const bool failed = r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid;
+    if (!o->export_path.empty() && !failed) {  // a result file: written only when the command succeeds
+      const relax::MomentRelaxation relaxation(problem, r.order);
+      sdp::WriteSdpaSparse(o->export_path, relaxation.lmi());
+    }
     const auto names = problem.names.empty() ? default_variable_names(problem.num_vars) : problem.names;
     if (o->json) {
       nlohmann::json j = relax::RelaxationJson(problem, r, o->solver);
-      if (!o->export_path.empty()) j["exported"] = o->export_path;
+      if (!o->export_path.empty() && !failed) j["exported"] = o->export_path;
       fmt::print("{}\n", j.dump(2));
     } else {
       fmt::print("order {} relaxation ({} moments, {} blocks), solver {}: {}\n", r.order, r.num_moments, r.num_blocks,
@@ -52,10 +82,9 @@ void AddPopCommand(CLI::App& app) {
       } else {
         fmt::print("{}\n", r.message);
       }
-      if (!o->export_path.empty()) fmt::print("wrote {}\n", o->export_path);
+      if (!o->export_path.empty() && !failed) fmt::print("wrote {}\n", o->export_path);
     }
-    if (r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid)
-      throw std::runtime_error("no valid bound: " + r.message);
+    if (failed) throw std::runtime_error("no valid bound: " + r.message + (o->export_path.empty() ? "" : "; nothing exported"));
   });
 }
 

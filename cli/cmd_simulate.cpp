@@ -1,4 +1,5 @@
 // `hwbounds simulate`: run a model JSON on an input recording and write y = w + noise.
+#include <cmath>
 #include <random>
 
 #include <fmt/format.h>
@@ -6,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
 #include "core/recording.hpp"
 
@@ -20,21 +22,30 @@ void AddSimulateCommand(CLI::App& app) {
     double snr_db = 31.0;
     double noise_std = 0.0, noise_bound = 0.0;
     unsigned seed = 1;
+    bool allow_unstable = false;
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("--model", o->model, "model JSON (see README: Model JSON)");
-  cmd->add_option("--input", o->input, "recording with the input column (CSV, or FILE.mat:u=VAR)");
-  cmd->add_option("--example", o->example,
-                  "built-in example instead of --model/--input: cerone2011 (paper 001, Section VI)")
-      ->check(CLI::IsMember({"cerone2011"}));
-  cmd->add_option("--samples", o->samples, "samples of the built-in example")->check(CLI::Range(10, 10000000));
-  cmd->add_option("--snr-db", o->snr_db, "SNR_w of the built-in example (bounded uniform noise)");
-  cmd->add_option("--u-col", o->u_col, "input column name");
-  cmd->add_option("--noise-std", o->noise_std, "Gaussian output noise standard deviation");
-  cmd->add_option("--noise-bound", o->noise_bound, "uniform output noise in [-b, b] (bounded-error setting)");
+  auto* model = cmd->add_option("--model", o->model, "model JSON (see README: Model JSON)");
+  auto* input = cmd->add_option("--input", o->input, "recording with the input column (CSV, or FILE.mat:u=VAR)");
+  auto* example = cmd->add_option("--example", o->example,
+                                  "built-in example instead of --model/--input: cerone2011 (paper 001, Section VI)")
+                      ->check(CLI::IsMember({"cerone2011"}));
+  auto* samples = cmd->add_option("--samples", o->samples, "samples of the built-in example")->check(CLI::Range(10, 10000000));
+  auto* snr = cmd->add_option("--snr-db", o->snr_db, "SNR_w of the built-in example (bounded uniform noise)");
+  auto* u_col = cmd->add_option("--u-col", o->u_col, "input column name");
+  auto* noise_std = cmd->add_option("--noise-std", o->noise_std, "Gaussian output noise standard deviation")
+                        ->check(CLI::NonNegativeNumber);
+  auto* noise_bound = cmd->add_option("--noise-bound", o->noise_bound, "uniform output noise in [-b, b] (bounded-error setting)")
+                          ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--allow-unstable", o->allow_unstable,
+                "simulate a model whose linear block is unstable (its output grows without bound)");
   cmd->add_option("--seed", o->seed, "random seed");
   cmd->add_option("--out", o->out, "output CSV")->required();
+  // The example has its own input, model and noise; a model run has no example settings.
+  for (auto* opt : {model, input, u_col, noise_std, noise_bound}) example->excludes(opt);
+  for (auto* opt : {samples, snr}) opt->needs(example);
   cmd->callback([o] {
+    CheckOutputFile(o->out, "--out");
     if (!o->example.empty()) {
       const auto ex = SimulateCeroneExample(o->seed, o->samples, o->snr_db);
       CsvTable out;
@@ -53,9 +64,18 @@ void AddSimulateCommand(CLI::App& app) {
     if (o->model.empty() || o->input.empty())
       throw InputError("simulate needs --model and --input, or --example NAME");
     const HwModel model = HwModel::load(o->model);
+    if (!model.linear.is_stable() && !o->allow_unstable)
+      throw InputError(fmt::format("{}: the linear block a = [{}] has a pole on or outside the unit circle, so its "
+                                   "output grows without bound; pass --allow-unstable to simulate it anyway",
+                                   o->model, fmt::join(model.linear.a, ", ")));
     const CsvTable in = read_recording(o->input, {o->u_col});
     const auto& u = in.column(o->u_col);
     const auto w = model.simulate(u);
+    for (std::size_t t = 0; t < w.size(); ++t)
+      if (!std::isfinite(w[t]))
+        throw InputError(fmt::format("{}: the simulated output overflows double precision at sample {} ({}:{}); "
+                                     "nothing was written",
+                                     o->model, t + 1, o->input, in.lines.at(t)));
     std::mt19937_64 rng(o->seed);
     std::normal_distribution<double> gauss(0.0, 1.0);
     std::uniform_real_distribution<double> unif(-1.0, 1.0);

@@ -6,6 +6,12 @@
 
 namespace hw::cli {
 
+// Thrown by a command after it has written its results, to end with a documented non-zero exit status
+// (e.g. `bounds`: 3 when the data invalidate the model).
+struct CommandExit {
+  int code = 1;
+};
+
 void AddSimulateCommand(CLI::App& app);
 void AddPopCommand(CLI::App& app);
 void AddBoundsCommand(CLI::App& app);

@@ -32,6 +32,24 @@ const std::vector<std::string>& QuantityOrder() {
 
 std::string G(double v) { return fmt::format("{:.4g}", v); }
 
+// Text inside a Markdown table cell: '|' would end the cell (as in "|G|") and a newline the row.
+std::string Cell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += "\\|";
+    else if (c == '\n' || c == '\r') out += ' ';
+    else out += c;
+  }
+  return out;
+}
+
+// Why the set-membership curves may be flat: they are drawn from the model at the intervals' centres.
+constexpr const char* kMidpointNote =
+    "The set-membership curves (static curve, frequency response, validation fit) are those of the model at the "
+    "centres of its guaranteed intervals: a point inside the intervals, not an estimate the method makes. When the "
+    "intervals span most of the prior box, their centres lie near 0 (gamma, b near 0), so the static curve is "
+    "nearly flat; that shows how wide the intervals are, not a fitted model.";
+
 }  // namespace
 
 std::string SummaryMarkdown(const json& s) {
@@ -42,12 +60,12 @@ std::string SummaryMarkdown(const json& s) {
   md += "## Methods\n\n| method | applies | runs ok | failed | note |\n|---|---|---|---|---|\n";
   for (const auto& [name, m] : s["methods"].items()) {
     if (!m.value("applicable", false)) {
-      md += fmt::format("| {} | no | - | - | {} |\n", name, m.value("reason", ""));
+      md += fmt::format("| {} | no | - | - | {} |\n", Cell(name), Cell(m.value("reason", "")));
       continue;
     }
     std::string note;
     for (const auto& f : m["failures"]) note += fmt::format("run {}: {}; ", f["run"].get<int>(), f["message"].get<std::string>());
-    md += fmt::format("| {} | yes | {} | {} | {} |\n", name, m.value("runs_ok", 0), m["failures"].size(), note);
+    md += fmt::format("| {} | yes | {} | {} | {} |\n", Cell(name), m.value("runs_ok", 0), m["failures"].size(), Cell(note));
   }
   md += "\n## Accuracy (normalisation-free quantities)\n\n"
         "| method | quantity | runs | mean | std | worst |\n|---|---|---|---|---|---|\n";
@@ -56,11 +74,11 @@ std::string SummaryMarkdown(const json& s) {
     for (const auto& q : QuantityOrder()) {
       if (m.contains("quantities") && m["quantities"].contains(q)) {
         const auto& st = m["quantities"][q];
-        md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", name, QuantityLabel(q), st["n"].get<int>(),
+        md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", Cell(name), Cell(QuantityLabel(q)), st["n"].get<int>(),
                           G(st["mean"]), G(st["std"]), G(st["worst"]));
       } else if (m.contains("not_available") && m["not_available"].contains(q)) {
-        md += fmt::format("| {} | {} | 0 | n/a | | {} |\n", name, QuantityLabel(q),
-                          m["not_available"][q].get<std::string>());
+        md += fmt::format("| {} | {} | 0 | n/a | | {} |\n", Cell(name), Cell(QuantityLabel(q)),
+                          Cell(m["not_available"][q].get<std::string>()));
       }
     }
   }
@@ -75,7 +93,7 @@ std::string SummaryMarkdown(const json& s) {
                       name, c["covered"].get<int>(), c["total"].get<int>(), c["runs_all_guaranteed"].get<int>(),
                       c["runs"].get<int>());
     for (const auto& [p, v] : c["per_parameter"].items())
-      md += fmt::format("| {} | {} | {} / {} | {} | {} | {} |\n", p, G(v["truth"]), v["covered"].get<int>(),
+      md += fmt::format("| {} | {} | {} / {} | {} | {} | {} |\n", Cell(p), G(v["truth"]), v["covered"].get<int>(),
                         v["runs"].get<int>(), G(v["width"]["mean"]), G(v["width"]["std"]), G(v["width"]["worst"]));
   }
   bool header = false;
@@ -88,23 +106,33 @@ std::string SummaryMarkdown(const json& s) {
       header = true;
     }
     for (const auto& [p, v] : m["inside_setmembership_intervals"].items())
-      md += fmt::format("| {} | {} | {} / {} | {} | {} |\n", name, p, v["inside"].get<int>(), v["runs"].get<int>(),
-                        v["mapping"].get<std::string>(), G(v["max_projection_residual"]));
+      md += fmt::format("| {} | {} | {} / {} | {} | {} |\n", Cell(name), Cell(p), v["inside"].get<int>(),
+                        v["runs"].get<int>(), Cell(v["mapping"].get<std::string>()), G(v["max_projection_residual"]));
   }
   md += "\n## Run time per method and run\n\n| method | runs | mean [s] | std [s] | max [s] | total [s] |\n"
         "|---|---|---|---|---|---|\n";
   for (const auto& [name, m] : s["methods"].items())
     if (m.contains("time"))
-      md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", name, m["time"]["n"].get<int>(), G(m["time"]["mean"]),
+      md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", Cell(name), m["time"]["n"].get<int>(), G(m["time"]["mean"]),
                         G(m["time"]["std"]), G(m["time"]["max"]), G(m["time"]["total"]));
   md += fmt::format("\nTimes are wall seconds inside a worker process ({} workers sharing the machine).\n",
                     s.value("jobs", 0));
+  if (s["methods"].contains("setmembership") && s["methods"]["setmembership"].contains("quantities"))
+    md += fmt::format("\n{}\n", kMidpointNote);
   if (!s.value("coverage_ok", true))
     md += "\n**COVERAGE FAILURE: a guaranteed interval excluded the truth (see runs/*.json).**\n";
   if (s.contains("plots_note") && !s["plots_note"].get<std::string>().empty())
     md += "\nPlots: " + s["plots_note"].get<std::string>() + "\n";
   return md;
 }
+
+namespace {
+// Legend entry of a method's curves; the set-membership one says what its curve is.
+std::string CurveTitle(const std::string& method) {
+  if (method == "setmembership") return "setmembership: model at the interval centres, every run (flat = wide intervals)";
+  return method + " (every run)";
+}
+}  // namespace
 
 std::string WritePlots(const std::string& dir, const Scenario& scenario, const std::vector<json>& runs,
                        const json& summary) {
@@ -221,17 +249,18 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
     const std::string style = backlash ? "points pt 7" : "lines lw 1";
     if (!sd.empty() && sd.find_first_not_of('\n') != std::string::npos) {
       write_text_atomic(fmt::format("{}/static_{}.dat", pd, methods[k]), sd);
-      splot += fmt::format(", 'static_{}.dat' with lines lw 1 lc rgb '{}' title '{} (every run)'", methods[k],
-                           colours[k % 3], methods[k]);
+      splot += fmt::format(", 'static_{}.dat' with lines lw 1 lc rgb '{}' title '{}'", methods[k], colours[k % 3],
+                           CurveTitle(methods[k]));
     }
     if (!fd.empty() && fd.find_first_not_of('\n') != std::string::npos) {
       write_text_atomic(fmt::format("{}/freq_{}.dat", pd, methods[k]), fd);
-      fplot += fmt::format(", 'freq_{}.dat' with {} lc rgb '{}' title '{} (every run)'", methods[k], style,
-                           colours[k % 3], methods[k]);
+      fplot += fmt::format(", 'freq_{}.dat' with {} lc rgb '{}' title '{}'", methods[k], style, colours[k % 3],
+                           CurveTitle(methods[k]));
     }
   }
-  gp += fmt::format("set output 'static_curves.png'\nset title 'Static input-output curve y_ss(u)'\n"
-                    "set xlabel 'u'\nset ylabel 'y_ss'\nplot {}\n", splot);
+  // gnuplot's enhanced text reads '_' as a subscript of one character: y_{ss} is "y" with subscript "ss".
+  gp += fmt::format("set output 'static_curves.png'\nset title 'Static input-output curve y_{{ss}}(u)'\n"
+                    "set xlabel 'u'\nset ylabel 'y_{{ss}}'\nplot {}\n", splot);
   gp += fmt::format("set output 'frequency_response.png'\nset title '{}'\n"
                     "set xlabel 'omega [rad/{}]'\nset ylabel 'normalised gain (log scale)'\nset logscale y\n{}plot {}\n",
                     backlash ? "Normalised |G(jw)|/|G(0)|" : "Normalised |G(e^{jw})|/|G(1)|", backlash ? "s" : "sample",

@@ -4,27 +4,17 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 #include "estimators/esmaeilani/valve_case.hpp"
 #include "relax/basis.hpp"
 
 namespace hw::compare {
 namespace {
-
-void CheckKeys(const nlohmann::json& j, const std::set<std::string>& allowed, const std::string& where) {
-  if (!j.is_object()) throw InputError(fmt::format("{}: expected a JSON object", where));
-  for (const auto& [key, value] : j.items())
-    if (!allowed.count(key)) {
-      std::string all;
-      for (const auto& a : allowed) all += (all.empty() ? "" : ", ") + a;
-      throw InputError(fmt::format("{}: unknown key '{}'; allowed keys: {}", where, key, all));
-    }
-}
 
 void ReadHold(const nlohmann::json& j, const std::string& where, int* lo, int* hi) {
   if (!j.contains("hold")) return;
@@ -154,7 +144,11 @@ Scenario Scenario::FromJson(const nlohmann::json& j, const std::string& source) 
     if (plant == "hw") {
       s.kind = PlantKind::kDiscreteHw;
       if (j.contains("model")) {
-        s.plant.model = HwModel::from_json(j.at("model"));
+        try {
+          s.plant.model = HwModel::from_json(j.at("model"));
+        } catch (const InputError& e) {
+          throw InputError(fmt::format("{}: model: {}", source, e.what()));
+        }
       } else if (j.contains("model_file")) {
         auto path = std::filesystem::path(j.at("model_file").get<std::string>());
         if (path.is_relative()) path = std::filesystem::path(source).parent_path() / path;
@@ -166,8 +160,12 @@ Scenario Scenario::FromJson(const nlohmann::json& j, const std::string& source) 
         s.plant.inverse_output = j.at("output_inverse_polynomial").get<std::vector<double>>();
     } else if (plant == "backlash") {
       s.kind = PlantKind::kBacklash;
-      s.backlash = j.contains("system") ? brouri::BacklashHwSystem::from_json(j.at("system"))
-                                        : brouri::BacklashHwSystem::PaperExample();
+      try {
+        s.backlash = j.contains("system") ? brouri::BacklashHwSystem::from_json(j.at("system"))
+                                          : brouri::BacklashHwSystem::PaperExample();
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: system: {}", source, e.what()));
+      }
     } else if (plant == "valve") {
       s.kind = PlantKind::kValve;
       esmaeilani::ValveCase valve;
@@ -256,16 +254,10 @@ Scenario LoadScenario(const std::string& name_or_path) {
   if (name_or_path == "brouri-backlash")
     return Scenario::FromJson(nlohmann::json::parse(kBrouriBacklash), "built-in brouri-backlash");
   if (name_or_path == "valve") return Scenario::FromJson(nlohmann::json::parse(kValve), "built-in valve");
-  std::ifstream in(name_or_path);
-  if (!in)
-    throw InputError(fmt::format("--scenario '{}': neither a built-in scenario ({}) nor a readable JSON file",
+  if (!std::filesystem::exists(name_or_path))
+    throw InputError(fmt::format("--scenario '{}': neither a built-in scenario ({}) nor an existing JSON file",
                                  name_or_path, fmt::join(BuiltinScenarioNames(), ", ")));
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", name_or_path, e.what()));
-  }
+  const nlohmann::json j = ReadJsonFile(name_or_path, "scenario JSON file");
   return Scenario::FromJson(j, name_or_path);
 }
 

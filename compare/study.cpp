@@ -16,6 +16,7 @@
 
 #include "compare/methods.hpp"
 #include "core/csv_table.hpp"
+#include "core/worker_process.hpp"
 
 namespace hw::compare {
 namespace {
@@ -195,10 +196,12 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   std::vector<pid_t> children;
   if (!pending.empty()) {
     std::fflush(nullptr);
+    const pid_t parent = getpid();
     for (int w = 0; w < jobs; ++w) {
       const pid_t pid = fork();
       if (pid < 0) throw std::runtime_error("compare: fork failed");
       if (pid == 0) {
+        EndWithParent(parent);
         int code = 0;
         for (std::size_t i = w; i < pending.size(); i += jobs) {
           const int r = pending[i];

@@ -1,6 +1,8 @@
 #include "core/csv_table.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -53,7 +55,8 @@ void CsvTable::add_column(const std::string& name, std::vector<double> values) {
 CsvTable parse_csv(const std::string& text, const std::string& source, bool allow_nonfinite) {
   CsvTable table;
   table.source = source;
-  std::istringstream in(text);
+  // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
+  std::istringstream in(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);
   std::string line;
   int line_no = 0;
   bool have_header = false;
@@ -64,24 +67,32 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
     auto cells = split(t);
     if (!have_header) {
       table.names = cells;
-      for (std::size_t i = 0; i < cells.size(); ++i)
+      for (std::size_t i = 0; i < cells.size(); ++i) {
         if (cells[i].empty())
           throw InputError(fmt::format("{}:{}: header column {} has no name; expected a header such as 't,u,y'",
                                        source, line_no, i + 1));
+        for (std::size_t k = 0; k < i; ++k)
+          if (cells[k] == cells[i])
+            throw InputError(fmt::format("{}:{}: the header names column '{}' twice (columns {} and {}); every "
+                                         "column needs its own name",
+                                         source, line_no, cells[i], k + 1, i + 1));
+      }
       table.columns.assign(cells.size(), {});
       have_header = true;
       continue;
     }
-    // Trailing empty cells are allowed (e.g. the WH benchmark's 'fs' column only in row 1).
-    if (cells.size() > table.names.size())
-      throw InputError(fmt::format("{}:{}: {} cells but the header has {} columns", source, line_no,
-                                   cells.size(), table.names.size()));
+    // With allow_nonfinite, missing trailing cells read as NaN (e.g. a column filled in the first row only);
+    // otherwise a short row is an error that counts its cells.
+    if (cells.size() > table.names.size() || (cells.size() < table.names.size() && !allow_nonfinite))
+      throw InputError(fmt::format("{}:{}: {} cells but the header has {} columns ({})", source, line_no,
+                                   cells.size(), table.names.size(), fmt::join(table.names, ", ")));
     for (std::size_t c = 0; c < table.names.size(); ++c) {
       double v = std::nan("");
       if (c < cells.size() && !cells[c].empty()) {
         char* end = nullptr;
         v = std::strtod(cells[c].c_str(), &end);
-        if (end == cells[c].c_str() || *end != '\0')
+        // Decimal numbers only: strtod would also read hexadecimal ("0x10" as 16).
+        if (end == cells[c].c_str() || *end != '\0' || cells[c].find_first_of("xXpP") != std::string::npos)
           throw InputError(fmt::format("{}:{}: column '{}' holds '{}', which is not a number", source,
                                        line_no, table.names[c], cells[c]));
       }
@@ -91,32 +102,50 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
                                      c < cells.size() && !cells[c].empty() ? cells[c] : "empty"));
       table.columns[c].push_back(v);
     }
+    table.lines.push_back(line_no);
   }
   if (!have_header) throw InputError(fmt::format("{}: empty file; expected a header line and data rows", source));
   if (table.rows() == 0) throw InputError(fmt::format("{}: header but no data rows", source));
   return table;
 }
 
-CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+std::string read_text_file(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status)) throw InputError(fmt::format("{}: no such file; expected a {}", path, what));
+  if (fs::is_directory(status)) throw InputError(fmt::format("{}: is a directory; expected a {}", path, what));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open ({}); expected a readable {}", path, std::strerror(errno), what));
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_csv(ss.str(), path, allow_nonfinite);
+  if (in.bad()) throw InputError(fmt::format("{}: read error; expected a readable {}", path, what));
+  return ss.str();
+}
+
+CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
+  return parse_csv(read_text_file(path, "CSV file"), path, allow_nonfinite);
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot write", tmp));
-    out << text;
-    if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
+  std::error_code ec;
+  try {
+    {
+      std::ofstream out(tmp, std::ios::binary);
+      if (!out) throw std::runtime_error(fmt::format("{}: cannot write ({})", tmp, std::strerror(errno)));
+      out << text;
+      out.flush();
+      if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
+    }
+    std::filesystem::rename(tmp, path);
+  } catch (const std::exception& e) {
+    std::filesystem::remove(tmp, ec);  // never leave a half-written file behind
+    throw std::runtime_error(fmt::format("{}: not written: {}", path, e.what()));
   }
-  std::filesystem::rename(tmp, path);
 }
 
-void write_csv(const std::string& path, const CsvTable& table, int precision) {
+std::string format_csv(const CsvTable& table, int precision) {
   std::string out;
   for (std::size_t c = 0; c < table.names.size(); ++c) out += (c ? "," : "") + table.names[c];
   out += '\n';
@@ -125,7 +154,11 @@ void write_csv(const std::string& path, const CsvTable& table, int precision) {
       out += (c ? "," : "") + fmt::format("{:.{}g}", table.columns[c][r], precision);
     out += '\n';
   }
-  write_text_atomic(path, out);
+  return out;
+}
+
+void write_csv(const std::string& path, const CsvTable& table, int precision) {
+  write_text_atomic(path, format_csv(table, precision));
 }
 
 }  // namespace hw

@@ -17,6 +17,7 @@ struct CsvTable {
   std::string source;                      // file name, for messages
   std::vector<std::string> names;          // header, in file order
   std::vector<std::vector<double>> columns;
+  std::vector<int> lines;                  // file line (1-based) of each data row, for messages; may be empty
 
   std::size_t rows() const { return columns.empty() ? 0 : columns.front().size(); }
   bool has(const std::string& name) const;
@@ -30,8 +31,13 @@ struct CsvTable {
 CsvTable read_csv(const std::string& path, bool allow_nonfinite = false);
 CsvTable parse_csv(const std::string& text, const std::string& source, bool allow_nonfinite = false);
 
+// The whole file as text. A missing path, a directory or an unreadable file is an InputError naming the
+// file and what it should be (`what`, e.g. "CSV file").
+std::string read_text_file(const std::string& path, const std::string& what = "file");
+
 // Writes atomically: to path + ".tmp", then rename, so a killed run leaves no half-written file.
 void write_csv(const std::string& path, const CsvTable& table, int precision = 12);
+std::string format_csv(const CsvTable& table, int precision = 12);  // the text write_csv writes
 void write_text_atomic(const std::string& path, const std::string& text);
 
 }  // namespace hw

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 
 namespace hw {
 
@@ -38,6 +39,9 @@ bool StaticMap::IsValid(std::string* error) const {
     return false;
   };
   if (kind == Kind::kPolynomial && coefficients.empty()) return fail("polynomial map needs coefficients");
+  for (const auto* values : {&coefficients, &x, &y})
+    for (double v : *values)
+      if (!std::isfinite(v)) return fail("static map: every number must be finite");
   if (kind == Kind::kPiecewiseLinear) {
     if (x.empty() || x.size() != y.size()) return fail("piecewise-linear map needs equally long, non-empty x and y");
     for (std::size_t i = 1; i < x.size(); ++i)
@@ -75,19 +79,25 @@ nlohmann::json StaticMap::to_json() const {
 
 StaticMap StaticMap::from_json(const nlohmann::json& j) {
   StaticMap m;
-  const std::string kind = j.value("kind", "");
+  if (!j.is_object() || !j.contains("kind") || !j.at("kind").is_string())
+    throw InputError("static map: expected {\"kind\": \"identity\" | \"polynomial\" | \"piecewise_linear\", ...}");
+  const std::string kind = j.at("kind").get<std::string>();
+  const std::string where = fmt::format("static map of kind '{}'", kind);
   try {
     if (kind == "identity") {
+      CheckKeys(j, {"kind"}, where);
       m.kind = Kind::kIdentity;
     } else if (kind == "polynomial") {
+      CheckKeys(j, {"kind", "coefficients"}, where);
       m = Polynomial(j.at("coefficients").get<std::vector<double>>());
     } else if (kind == "piecewise_linear") {
+      CheckKeys(j, {"kind", "x", "y"}, where);
       m = PiecewiseLinear(j.at("x").get<std::vector<double>>(), j.at("y").get<std::vector<double>>());
     } else {
       throw InputError(fmt::format("static map kind '{}' unknown; expected identity, polynomial or piecewise_linear", kind));
     }
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("static map of kind '{}': {}", kind, e.what()));
+    throw InputError(fmt::format("{}: {}", where, e.what()));
   }
   std::string err;
   if (!m.IsValid(&err)) throw InputError(err);
@@ -95,6 +105,12 @@ StaticMap StaticMap::from_json(const nlohmann::json& j) {
 }
 
 bool LinearBlock::IsValid(std::string* error) const {
+  for (const auto* values : {&a, &b})
+    for (double v : *values)
+      if (!std::isfinite(v)) {
+        if (error) *error = "linear block: every coefficient must be finite";
+        return false;
+      }
   if (b.empty()) {
     if (error) *error = "linear block needs at least one b coefficient";
     return false;
@@ -102,6 +118,21 @@ bool LinearBlock::IsValid(std::string* error) const {
   if (delay < 0) {
     if (error) *error = "linear block delay must be >= 0";
     return false;
+  }
+  return true;
+}
+
+bool LinearBlock::is_stable() const {
+  // Step-down recursion: A_m(z) -> A_{m-1}(z) with reflection coefficient k_m = last coefficient of A_m;
+  // all poles lie inside the unit circle iff every |k_m| < 1.
+  std::vector<double> c = {1.0};
+  c.insert(c.end(), a.begin(), a.end());
+  for (std::size_t m = c.size() - 1; m >= 1; --m) {
+    const double k = c[m];
+    if (!(std::abs(k) < 1.0)) return false;
+    std::vector<double> next(m);
+    for (std::size_t i = 0; i < m; ++i) next[i] = (c[i] - k * c[m - i]) / (1.0 - k * k);
+    c = std::move(next);
   }
   return true;
 }
@@ -141,17 +172,25 @@ nlohmann::json HwModel::to_json() const {
           {"output_nonlinearity", output.to_json()}};
 }
 
-HwModel HwModel::from_json(const nlohmann::json& j) {
+HwModel HwModel::from_json(const nlohmann::json& j, const std::vector<std::string_view>& extension_keys) {
   HwModel m;
+  std::vector<std::string_view> keys = {"type", "name", "input_nonlinearity", "linear", "output_nonlinearity",
+                                        "esmaeilani"};
+  keys.insert(keys.end(), extension_keys.begin(), extension_keys.end());
   try {
+    CheckKeys(j, keys, "model JSON");
     if (j.value("type", "hammerstein_wiener") != "hammerstein_wiener")
       throw InputError(fmt::format("model type '{}' unknown; expected hammerstein_wiener", j.value("type", "")));
     m.name = j.value("name", "");
     if (j.contains("input_nonlinearity")) m.input = StaticMap::from_json(j.at("input_nonlinearity"));
     if (j.contains("output_nonlinearity")) m.output = StaticMap::from_json(j.at("output_nonlinearity"));
+    if (!j.contains("linear")) throw InputError("model JSON: \"linear\": {\"a\": [...], \"b\": [...]} is required");
     const auto& lin = j.at("linear");
+    CheckKeys(lin, {"a", "b", "delay"}, "model JSON: linear");
     m.linear.a = lin.value("a", std::vector<double>{});
     m.linear.b = lin.at("b").get<std::vector<double>>();
+    if (lin.contains("delay") && !lin.at("delay").is_number_integer())
+      throw InputError("model JSON: linear.delay must be a whole number of samples");
     m.linear.delay = lin.value("delay", 0);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("model JSON: {} (expected keys: linear.a, linear.b, linear.delay, "
@@ -163,14 +202,7 @@ HwModel HwModel::from_json(const nlohmann::json& j) {
 }
 
 HwModel HwModel::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open model file", path));
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
-  }
+  const nlohmann::json j = ReadJsonFile(path, "model JSON file");
   try {
     return from_json(j);
   } catch (const InputError& e) {

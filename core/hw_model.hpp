@@ -6,6 +6,7 @@
 // Linear block convention (paper 001 eq. 3, used everywhere in hwbounds):
 //   z_t = -sum_{i=1..na} a_i z_{t-i} + sum_{j=0..nb} b_j x_{t-delay-j}
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -34,6 +35,9 @@ struct LinearBlock {
   int delay = 0;          // extra input delay in samples
 
   bool IsValid(std::string* error) const;
+  // True when every pole of 1 / (1 + a_1 q^-1 + ... + a_na q^-na) lies strictly inside the unit circle
+  // (Schur-Cohn test); an unstable block's simulation grows without bound.
+  bool is_stable() const;
   // Simulates from rest (zero initial state).
   std::vector<double> simulate(const std::vector<double>& x) const;
 };
@@ -47,7 +51,9 @@ struct HwModel {
   bool IsValid(std::string* error) const;
   std::vector<double> simulate(const std::vector<double>& u) const;  // noise-free w
   nlohmann::json to_json() const;
-  static HwModel from_json(const nlohmann::json& j);  // throws InputError
+  // Throws InputError, also for a key outside the format ("esmaeilani", the estimator's record, is part of
+  // it); `extension_keys` are further keys a caller reads itself (e.g. an augmented model's effect block).
+  static HwModel from_json(const nlohmann::json& j, const std::vector<std::string_view>& extension_keys = {});
   static HwModel load(const std::string& path);
   void save(const std::string& path) const;
 };

@@ -235,9 +235,17 @@ long MonomialBasis::index_of(const Exponents& e) const {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Parser: expr := term (('+'|'-') term)* ; term := unary (('*')? unary)* ; unary := ('-'|'+') unary | power
+// Parser: expr := term (('+'|'-') term)* ; term := unary (('*'|'/') unary)* ; unary := ('-'|'+') unary | power
 // power := atom ('^' integer)? ; atom := number | name | '(' expr ')'
+// Every product needs its '*': "2x1" or "x1 x2" is a missing operator, not a product, so that a typo such
+// as "x1^0.5" (which would otherwise read as x1^0 times .5) is an error with its position.
 namespace {
+
+// Limits that keep a mistyped or hostile expression from expanding without bound.
+constexpr int kMaxExponent = 64;
+constexpr int kMaxDegree = 256;
+constexpr std::size_t kMaxTermProducts = 1'000'000;  // work of one product of expanded polynomials
+constexpr int kMaxNesting = 200;                     // parentheses and signs: keeps the recursion off the stack limit
 
 class Parser {
  public:
@@ -248,7 +256,15 @@ class Parser {
     if (pos_ >= s_.size()) fail("empty expression; expected a polynomial such as 2*x1^2 - x2 + 1");
     Polynomial p = expr();
     skip();
-    if (pos_ < s_.size()) fail(fmt::format("unexpected '{}'; expected an operator (+, -, *, ^) or the end", s_[pos_]));
+    if (pos_ < s_.size()) {
+      if (starts_atom()) fail(missing_operator());
+      fail(fmt::format("unexpected '{}'; expected an operator (+, -, *, /, ^) or the end", s_[pos_]));
+    }
+    for (const auto& [e, c] : p.terms())
+      if (!std::isfinite(c)) {
+        pos_ = 0;
+        fail("a coefficient overflows double precision; rescale the numbers");
+      }
     return p;
   }
 
@@ -264,6 +280,21 @@ class Parser {
     return pos_ < s_.size() && s_[pos_] == c;
   }
   int n() const { return static_cast<int>(names_.size()); }
+  std::string missing_operator() const {
+    std::size_t end = pos_;
+    while (end < s_.size() && end < pos_ + 12 && !std::isspace(static_cast<unsigned char>(s_[end]))) ++end;
+    return fmt::format("missing operator before '{}'; write '*' for a product (e.g. 2*x1, x1*x2)",
+                       s_.substr(pos_, end - pos_));
+  }
+
+  Polynomial product(const Polynomial& a, const Polynomial& b, std::size_t at) {
+    if (a.terms().size() * b.terms().size() > kMaxTermProducts || a.degree() + b.degree() > kMaxDegree) {
+      pos_ = at;
+      fail(fmt::format("the expression expands beyond {} term products or degree {}; expand it less", kMaxTermProducts,
+                       kMaxDegree));
+    }
+    return a * b;
+  }
 
   Polynomial expr() {
     Polynomial p = term();
@@ -289,8 +320,8 @@ class Parser {
     Polynomial p = unary();
     while (true) {
       if (peek('*')) {
-        ++pos_;
-        p = p * unary();
+        const std::size_t at = pos_++;
+        p = product(p, unary(), at);
       } else if (peek('/')) {
         ++pos_;
         const std::size_t at = pos_;
@@ -304,14 +335,23 @@ class Parser {
           fail("division by zero");
         }
         p *= 1.0 / d.constant_term();
-      } else if (starts_atom()) {  // juxtaposition: "3 x1"
-        p = p * unary();
+      } else if (starts_atom()) {
+        fail(missing_operator());
       } else {
         return p;
       }
     }
   }
+  // Counts the recursion depth of one nested construct.
+  struct Nested {
+    Parser& p;
+    explicit Nested(Parser& parser) : p(parser) {
+      if (++p.depth_ > kMaxNesting) p.fail(fmt::format("nesting deeper than {} levels", kMaxNesting));
+    }
+    ~Nested() { --p.depth_; }
+  };
   Polynomial unary() {
+    const Nested guard(*this);
     if (peek('-')) {
       ++pos_;
       return -unary();
@@ -322,42 +362,77 @@ class Parser {
     }
     return power();
   }
+  // The exponent after '^': digits only, at most kMaxExponent.
+  int exponent() {
+    skip();
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    if (start == pos_) fail("expected a non-negative integer exponent after '^'");
+    if (pos_ < s_.size() && (s_[pos_] == '.' || s_[pos_] == 'e' || s_[pos_] == 'E')) {
+      pos_ = start;
+      fail("exponents must be non-negative integers (a polynomial has no fractional powers)");
+    }
+    const std::string digits = s_.substr(start, pos_ - start);
+    if (digits.size() > 3 || std::stoi(digits) > kMaxExponent) {
+      pos_ = start;
+      fail(fmt::format("exponent {} is larger than {}", digits, kMaxExponent));
+    }
+    return std::stoi(digits);
+  }
   Polynomial power() {
     Polynomial base = atom();
-    if (peek('^')) {
-      ++pos_;
-      skip();
-      const std::size_t start = pos_;
+    if (!peek('^')) return base;
+    const std::size_t at = pos_++;
+    const int k = exponent();
+    Polynomial r = Polynomial::Constant(n(), 1.0);
+    for (int i = 0; i < k; ++i) r = product(r, base, at);
+    return r;
+  }
+  // A decimal number: digits, an optional fraction, an optional exponent (no hex, inf or nan).
+  Polynomial number() {
+    const std::size_t start = pos_;
+    auto digits = [&] {
+      const std::size_t b = pos_;
       while (pos_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[pos_]))) ++pos_;
-      if (start == pos_) fail("expected a non-negative integer exponent after '^'");
-      const int k = std::stoi(s_.substr(start, pos_ - start));
-      if (k > 64) {
-        pos_ = start;
-        fail("exponent larger than 64 is not supported");
-      }
-      return base.pow(k);
+      return pos_ - b;
+    };
+    std::size_t mantissa = digits();
+    if (pos_ < s_.size() && s_[pos_] == '.') {
+      ++pos_;
+      mantissa += digits();
     }
-    return base;
+    if (mantissa == 0) {
+      pos_ = start;
+      fail("malformed number");
+    }
+    if (pos_ < s_.size() && (s_[pos_] == 'e' || s_[pos_] == 'E')) {
+      const std::size_t e = pos_++;
+      if (pos_ < s_.size() && (s_[pos_] == '+' || s_[pos_] == '-')) ++pos_;
+      if (digits() == 0) {
+        pos_ = e;
+        fail("malformed number: expected digits after the exponent 'e'");
+      }
+    }
+    const double v = std::strtod(s_.substr(start, pos_ - start).c_str(), nullptr);
+    if (!std::isfinite(v)) {
+      pos_ = start;
+      fail("number out of the range of double precision");
+    }
+    return Polynomial::Constant(n(), v);
   }
   Polynomial atom() {
     skip();
     if (pos_ >= s_.size()) fail("unexpected end; expected a number, a variable or '('");
     const char c = s_[pos_];
     if (c == '(') {
+      const Nested guard(*this);
       ++pos_;
       Polynomial p = expr();
       if (!peek(')')) fail("expected ')'");
       ++pos_;
       return p;
     }
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
-      const char* begin = s_.c_str() + pos_;
-      char* end = nullptr;
-      const double v = std::strtod(begin, &end);
-      if (end == begin) fail("malformed number");
-      pos_ += static_cast<std::size_t>(end - begin);
-      return Polynomial::Constant(n(), v);
-    }
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number();
     if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       const std::size_t start = pos_;
       while (pos_ < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_')) ++pos_;
@@ -375,6 +450,7 @@ class Parser {
   const std::string& s_;
   const std::vector<std::string>& names_;
   std::size_t pos_ = 0;
+  int depth_ = 0;
 };
 
 }  // namespace

@@ -95,8 +95,9 @@ struct PolynomialParseError : std::runtime_error {
   std::size_t position;  // 0-based character offset in the parsed text
 };
 
-// Parses text such as "2*x1^2*x3 - 0.5*x2 + 1" or "(x1 + x2)^2 - 3 x1" over the given variable names
-// (juxtaposition means multiplication). Errors give the position and the reason.
+// Parses text such as "2*x1^2*x3 - 0.5*x2 + 1" or "(x1 + x2)^2 - 3*x1" over the given variable names.
+// Every product needs '*' ("2x1" is an error), exponents are integers 0..64, numbers are decimal; errors give
+// the position and the reason.
 Polynomial parse_polynomial(const std::string& text, const std::vector<std::string>& names);
 
 // Names x1..xn.

@@ -30,13 +30,26 @@ bool HwData::IsValid(std::string* error) const {
   if (u.size() != y.size()) return fail(fmt::format("u has {} samples but y has {}", u.size(), y.size()));
   if (noise_bound.size() != y.size())
     return fail(fmt::format("the noise bound has {} samples but y has {}", noise_bound.size(), y.size()));
+  if (!lines.empty() && lines.size() != y.size())
+    return fail(fmt::format("{} line numbers for {} samples", lines.size(), y.size()));
   for (std::size_t t = 0; t < y.size(); ++t) {
-    if (!std::isfinite(u[t]) || !std::isfinite(y[t])) return fail(fmt::format("sample {} is not finite", t + 1));
-    if (!(noise_bound[t] > 0) || !std::isfinite(noise_bound[t]))
-      return fail(fmt::format("noise bound at sample {} is {}; it must be a positive finite number", t + 1,
-                              noise_bound[t]));
+    const int i = static_cast<int>(t);
+    if (!std::isfinite(u[t]) || !std::isfinite(y[t])) {
+      if (error) *error = where(i) + ": u or y is not finite";
+      return false;
+    }
+    if (!(noise_bound[t] > 0) || !std::isfinite(noise_bound[t])) {
+      if (error)
+        *error = fmt::format("{}: the noise bound is {}; it must be a positive finite number", where(i), noise_bound[t]);
+      return false;
+    }
   }
   return true;
+}
+
+std::string HwData::where(int t) const {
+  if (t >= 0 && static_cast<std::size_t>(t) < lines.size()) return fmt::format("{}:{} (sample {})", source, lines[t], t + 1);
+  return fmt::format("{}: sample {}", source, t + 1);
 }
 
 HwStructure CeroneExampleStructure() {
@@ -142,6 +155,8 @@ HwOuterSet::HwOuterSet(HwStructure structure, HwData data, int horizon, std::vec
     for (const auto& phi : structure_.output_basis)
       phi_range_[t].push_back(phi.range(data_.y[t] - data_.noise_bound[t], data_.y[t] + data_.noise_bound[t]));
 
+  CheckBasisValues();
+
   // x_t as polynomials (linear in gamma), cached per sample.
   std::vector<Polynomial> x(N, Polynomial(n));
   for (int t = 0; t < N; ++t)
@@ -168,6 +183,75 @@ HwOuterSet::HwOuterSet(HwStructure structure, HwData data, int horizon, std::vec
       equations_.push_back(std::move(eq));
     }
   }
+  build(0, true);  // products of finite values can still overflow: fail here, before any solver work
+}
+
+namespace {
+
+// The power of ten nearest to v > 0: the scaling suggested in messages.
+double PowerOfTen(double v) { return std::pow(10.0, std::round(std::log10(v))); }
+
+// Largest / smallest of the positive entries (1 when fewer than two).
+double Spread(const std::vector<double>& magnitudes) {
+  double lo = INFINITY, hi = 0.0;
+  for (double m : magnitudes)
+    if (m > 0) lo = std::min(lo, m), hi = std::max(hi, m);
+  return hi > 0 && lo < hi ? hi / lo : 1.0;
+}
+
+// The SDP solvers resolve about 8 significant digits; basis values spanning more make some parameters'
+// terms vanish into the others' rounding error.
+constexpr double kResolvedSpread = 1e8;
+
+}  // namespace
+
+void HwOuterSet::CheckBasisValues() {
+  const int N = static_cast<int>(data_.y.size());
+  double u_max = 0.0, y_max = 0.0;
+  for (int t = 0; t < N; ++t) u_max = std::max(u_max, std::abs(data_.u[t])), y_max = std::max(y_max, std::abs(data_.y[t]));
+  std::vector<double> in_max(structure_.input_basis.size(), 0.0), out_max(structure_.output_basis.size(), 0.0);
+  int lost_noise = 0, first_lost = -1;
+  for (int t = 0; t < N; ++t) {
+    for (std::size_t i = 0; i < in_max.size(); ++i) {
+      const auto& psi = structure_.input_basis[i];
+      const double v = psi.value(data_.u[t]);
+      if (!std::isfinite(v))
+        throw InputError(fmt::format("{}: u = {:g} gives {}(u) = {:g}, which overflows double precision, so no "
+                                     "constraint of this sample is finite; rescale column u (e.g. divide it by {:g}) "
+                                     "and the prior box with it",
+                                     data_.where(t), data_.u[t], psi.name, v, PowerOfTen(u_max)));
+      in_max[i] = std::max(in_max[i], std::abs(v));
+    }
+    for (std::size_t j = 0; j < out_max.size(); ++j) {
+      const auto [lo, hi] = phi_range_[t][j];
+      if (!std::isfinite(lo) || !std::isfinite(hi))
+        throw InputError(fmt::format("{}: y = {:g} (noise bound {:g}) gives {}(w) = {:g}..{:g}, which overflows double "
+                                     "precision, so no constraint of this sample is finite; rescale column y (e.g. "
+                                     "divide it and the noise bound by {:g}) and the prior box with it",
+                                     data_.where(t), data_.y[t], data_.noise_bound[t],
+                                     structure_.output_basis[j].name, lo, hi, PowerOfTen(y_max)));
+      out_max[j] = std::max(out_max[j], std::max(std::abs(lo), std::abs(hi)));
+    }
+    if (data_.y[t] + data_.noise_bound[t] == data_.y[t] || data_.y[t] - data_.noise_bound[t] == data_.y[t]) {
+      if (first_lost < 0) first_lost = t;
+      ++lost_noise;
+    }
+  }
+  auto warn_spread = [&](const std::vector<double>& magnitudes, const char* side, double max_abs, const char* column) {
+    if (Spread(magnitudes) <= kResolvedSpread) return;
+    warnings_.push_back(fmt::format(
+        "the {} basis values span {:.1e} (max |{}| = {:g}): the smallest terms lose all relative precision in the "
+        "solvers (about 8 digits); scale {} to max |{}| of about 1 (divide column {} by {:g}; the parameters and "
+        "the prior box scale with it)",
+        side, Spread(magnitudes), column, max_abs, column, column, column, PowerOfTen(max_abs)));
+  };
+  warn_spread(in_max, "input", u_max, "u");
+  warn_spread(out_max, "output", y_max, "y");
+  if (lost_noise > 0)
+    warnings_.push_back(fmt::format(
+        "at {} samples (first {}) the noise bound is below the resolution of y (y +- noise == y in double "
+        "precision): their noise band is lost; subtract an offset from y or rescale it",
+        lost_noise, data_.where(first_lost)));
 }
 
 std::vector<int> HwOuterSet::orthant_signs(int l) const {
@@ -225,6 +309,13 @@ std::vector<DataConstraint> HwOuterSet::build(int l, bool scaled) const {
       upper = upper.compose(scaled_vars_);
       lower = lower.compose(scaled_vars_);
     }
+    for (const auto* g : {&upper, &lower})
+      for (const auto& [e, c] : g->terms())
+        if (!std::isfinite(c))
+          throw InputError(fmt::format("{}: a coefficient of this sample's horizon-{} constraint overflows double "
+                                       "precision (products of the data's basis values and the prior box); rescale "
+                                       "u and y to magnitudes near 1 and the prior box with them",
+                                       data_.where(eq.t), eq.s));
     out.push_back({normalised(upper), eq.t, eq.s, true});
     out.push_back({normalised(lower), eq.t, eq.s, false});
   }

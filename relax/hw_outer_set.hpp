@@ -37,7 +37,10 @@ struct HwData {
   std::vector<double> u, y;
   std::vector<double> noise_bound;  // dy_t, per sample
   std::string source = "data";
+  std::vector<int> lines;           // file line of each sample (CsvTable::lines); empty: none
   bool IsValid(std::string* error) const;
+  // Where sample t (0-based) comes from, for messages: "rec.csv:17 (sample 12)" or "data: sample 12".
+  std::string where(int t) const;
 };
 
 // The model class of paper 001's example: psi = phi = (w, w^2, w^3), na = nb = 2, strictly proper.
@@ -95,6 +98,9 @@ class HwOuterSet {
   const HwData& data() const { return data_; }
   // The same data, model class and horizon in another box (a contracted one: same set inside it, new scaling).
   HwOuterSet WithBox(std::vector<std::pair<double, double>> box) const { return {structure_, data_, horizon_, std::move(box)}; }
+  // Numerical warnings about the data found at construction: basis values spanning more magnitudes than the
+  // solvers resolve, or noise bands below the resolution of a basis value, each with the scaling to use.
+  const std::vector<std::string>& warnings() const { return warnings_; }
   // Evaluates the unscaled model equations' worst-case slack of a parameter point (for tests):
   // min over constraints of the constraint value at p (>= 0 iff p lies in D^ss(n) for its orthant).
   double min_slack(const std::vector<double>& p) const;
@@ -113,6 +119,7 @@ class HwOuterSet {
     Polynomial rhs;  // original variables
   };
   std::vector<DataConstraint> build(int l, bool scaled) const;
+  void CheckBasisValues();  // non-finite basis values are errors; precision loss goes to warnings_
 
   HwStructure structure_;
   HwData data_;
@@ -126,6 +133,7 @@ class HwOuterSet {
   std::vector<Equation> equations_;
   // phi ranges per sample and basis function: [min, max] over [y - dy, y + dy].
   std::vector<std::vector<std::pair<double, double>>> phi_range_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace hw::relax

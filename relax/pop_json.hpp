@@ -6,7 +6,8 @@
 //   "constraints": ["x1^2 + x2^2 <= 1", "x1 - x2 == 0", "x2 >= -1"],
 //   "box": {"x1": [-2, 2], "x2": [-2, 2]}   (optional; all variables or none)
 // }
-// Errors name the file, the field and, inside an expression, the character position.
+// Errors name the file, the field and, inside an expression, the character position; a key other than these
+// five is an error (a typo such as "constraint" must not drop the constraints).
 #include <string>
 
 #include <nlohmann/json.hpp>

@@ -14,6 +14,8 @@
 
 #include <fmt/format.h>
 
+#include "core/worker_process.hpp"
+
 #ifdef HW_HAVE_MPI
 #include "sdp/mpi_executor.hpp"
 #endif
@@ -120,12 +122,26 @@ std::vector<JobResult> ForkExecutor::Map(const std::vector<std::string>& specs, 
   } kill_on_unwind{running};
   std::size_t next = 0;
   std::fflush(nullptr);  // buffered output must not be duplicated into the children
+  const pid_t parent = ::getpid();
+  // On an exception here (fork failure, a throwing on_done) no child is left running or unreaped.
+  struct Reaper {
+    std::map<int, Child>& running;
+    ~Reaper() {
+      for (auto& [fd, c] : running) {
+        ::kill(c.pid, SIGKILL);
+        ::close(fd);
+        while (::waitpid(c.pid, nullptr, 0) < 0 && errno == EINTR) {
+        }
+      }
+    }
+  } reaper{running};
   auto launch = [&](std::size_t i) {
     int fds[2];
     if (::pipe(fds) != 0) throw std::runtime_error(fmt::format("pipe: {}", std::strerror(errno)));
     const pid_t pid = ::fork();
     if (pid < 0) throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
     if (pid == 0) {
+      EndWithParent(parent);
       ::close(fds[0]);
       const JobResult r = RunJobGuarded(fn, specs[i]);
       const std::string msg = EncodeJobResult(r);

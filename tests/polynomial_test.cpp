@@ -10,7 +10,7 @@ TEST(Polynomial, ArithmeticAndEvaluation) {
   EXPECT_EQ(p.degree(), 3);
   EXPECT_DOUBLE_EQ(p.evaluate({1, 2, 3}), 2 * 1 * 3 - 1 + 1);
   auto q = parse_polynomial("(x1 + x2)^2", names);
-  auto expanded = parse_polynomial("x1^2 + 2 x1 x2 + x2^2", names);
+  auto expanded = parse_polynomial("x1^2 + 2*x1*x2 + x2^2", names);
   EXPECT_TRUE((q - expanded).is_zero());
   EXPECT_DOUBLE_EQ((p * q).evaluate({0.5, -1, 2}), p.evaluate({0.5, -1, 2}) * q.evaluate({0.5, -1, 2}));
 }
@@ -19,7 +19,7 @@ TEST(Polynomial, SubstitutionAndComposition) {
   const auto names = default_variable_names(2);
   auto p = parse_polynomial("x1^2 + x2", names);
   auto r = p.substitute(0, parse_polynomial("x2 + 1", names));
-  EXPECT_TRUE((r - parse_polynomial("x2^2 + 3 x2 + 1", names)).is_zero()) << r.to_string();
+  EXPECT_TRUE((r - parse_polynomial("x2^2 + 3*x2 + 1", names)).is_zero()) << r.to_string();
 }
 
 TEST(Polynomial, ParserReportsPositionAndReason) {

@@ -9,6 +9,8 @@
 
 #include "core/csv_table.hpp"
 #include "core/recording.hpp"
+#include "core/json_input.hpp"
+#include "estimators/brouri/outliers.hpp"
 
 namespace hw::brouri {
 
@@ -67,6 +69,9 @@ nlohmann::json StepPlan::to_json() const {
 
 StepPlan StepPlan::from_json(const nlohmann::json& j) {
   return ParseValidated<StepPlan>("step plan", [&] {
+    CheckKeys(j, {"method", "stage", "sample_time", "hold_samples", "average_samples", "reset_level", "levels_up",
+                  "levels_down", "file"},
+              "step plan");
     StepPlan p;
     p.sample_time = j.at("sample_time").get<double>();
     p.hold_samples = j.at("hold_samples").get<int>();
@@ -140,9 +145,12 @@ nlohmann::json SinePlan::to_json() const {
 
 SinePlan SinePlan::from_json(const nlohmann::json& j) {
   return ParseValidated<SinePlan>("sine plan", [&] {
+    CheckKeys(j, {"method", "stage", "amplitude", "experiments", "nonlinear"}, "sine plan");
     SinePlan p;
     p.amplitude = j.at("amplitude").get<double>();
     for (const auto& e : j.at("experiments")) {
+      CheckKeys(e, {"omega", "sample_time", "samples_per_period", "transient_periods", "periods", "file"},
+                "sine plan: experiments[]");
       SineExperiment x;
       x.omega = e.at("omega").get<double>();
       x.samples_per_period = e.at("samples_per_period").get<int>();
@@ -206,6 +214,13 @@ NonlinearEstimate EstimateFromSteps(const StepPlan& plan, const NonlinearOptions
   return est;
 }
 
+namespace {
+std::vector<std::size_t> OneBased(std::vector<std::size_t> v) {
+  for (auto& i : v) ++i;
+  return v;
+}
+}  // namespace
+
 FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const FrequencyOptions& options,
                                 const std::vector<double>& u, const std::vector<double>& y, Summary* summary) {
   const auto& e = plan.experiments.at(i);
@@ -224,10 +239,18 @@ FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const Frequ
                                  std::max(0.0, (static_cast<double>(y.size()) -
                                                 e.transient_periods * e.samples_per_period) /
                                                    e.samples_per_period)));
+  std::vector<std::size_t> outliers;
   const auto period = PeriodicAverage(y, static_cast<std::size_t>(e.transient_periods) * e.samples_per_period,
-                                      e.samples_per_period, e.periods);
+                                      e.samples_per_period, e.periods, &outliers);
   FrequencyPoint pt;
   EstimateFrequencyPoint(options, plan.nonlinear.h, plan.amplitude, e.omega, e.sample_time(), period, &pt, summary);
+  pt.outliers = outliers;
+  if (!outliers.empty())
+    summary->message += fmt::format("; warning: {}: sample{} {} left out of the periodic average as isolated "
+                                    "outlier{} (more than {:g} robust standard deviations from the phase's median "
+                                    "over the periods)",
+                                    e.file, outliers.size() > 1 ? "s" : "", fmt::join(OneBased(outliers), ", "),
+                                    outliers.size() > 1 ? "s" : "", kOutlierSigmas);
   return pt;
 }
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "estimators/brouri/outliers.hpp"
 
 namespace hw::brouri {
 
@@ -40,16 +41,41 @@ double Wrap(double a) {
 }  // namespace
 
 std::vector<double> PeriodicAverage(const std::vector<double>& y, std::size_t first, int samples_per_period,
-                                    int periods) {
+                                    int periods, std::vector<std::size_t>* outliers) {
   if (samples_per_period < 4 || periods < 1) throw InputError("periodic averaging needs >= 4 samples per period, >= 1 period");
   const std::size_t need = first + static_cast<std::size_t>(samples_per_period) * periods;
   if (y.size() < need)
     throw InputError(fmt::format("recording has {} samples; {} transient samples + {} periods x {} samples need {}",
                                  y.size(), first, periods, samples_per_period, need));
-  std::vector<double> x(samples_per_period, 0.0);
-  for (int l = 0; l < periods; ++l)
-    for (int i = 0; i < samples_per_period; ++i) x[i] += y[first + static_cast<std::size_t>(l) * samples_per_period + i];
-  for (double& v : x) v /= periods;
+  const std::size_t P = static_cast<std::size_t>(samples_per_period);
+  auto at = [&](int l, std::size_t i) { return first + static_cast<std::size_t>(l) * P + i; };
+  // In steady state every period repeats: each phase's samples scatter around their median by the noise only.
+  std::vector<double> median(P), residuals;
+  double top = 0.0;
+  for (std::size_t i = 0; i < P; ++i) {
+    std::vector<double> v(periods);
+    for (int l = 0; l < periods; ++l) v[l] = y[at(l, i)];
+    median[i] = Median(v);
+    top = std::max(top, std::abs(median[i]));
+    for (double x : v) residuals.push_back(x - median[i]);
+  }
+  const double threshold = periods >= 3 ? std::max(kOutlierSigmas * RobustSigma(residuals), kOutlierFloor * top)
+                                        : INFINITY;  // two periods cannot tell which one is wrong
+  std::vector<double> x(P, 0.0);
+  for (std::size_t i = 0; i < P; ++i) {
+    int n = 0;
+    for (int l = 0; l < periods; ++l) {
+      const double v = y[at(l, i)];
+      if (std::abs(v - median[i]) > threshold) {
+        if (outliers) outliers->push_back(at(l, i));
+        continue;
+      }
+      x[i] += v;
+      ++n;
+    }
+    x[i] /= n;
+  }
+  if (outliers) std::sort(outliers->begin(), outliers->end());
   return x;
 }
 
@@ -164,7 +190,7 @@ nlohmann::json ToJson(const FrequencyPoint& p) {
   for (const auto& x : p.harmonics) h.push_back({{"a", x.a}, {"b", x.b}, {"s", x.s}, {"psi", x.psi}});
   return {{"omega", p.omega},       {"amplitude", p.amplitude}, {"sample_time", p.sample_time},
           {"harmonic", p.harmonic}, {"gain", p.gain},           {"phase", p.phase},
-          {"fit_residual", p.fit_residual}, {"fourier", h}};
+          {"fit_residual", p.fit_residual}, {"fourier", h}, {"outliers", p.outliers}};
 }
 
 }  // namespace hw::brouri

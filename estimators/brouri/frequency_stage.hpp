@@ -27,8 +27,11 @@
 namespace hw::brouri {
 
 // Eq. 23: average of `periods` consecutive periods of `samples_per_period` samples starting at `first`.
+// With three or more periods, isolated outliers (a sample far outside the noise of its phase across the
+// periods, estimators/brouri/outliers.hpp) are left out of their phase's average and listed in `outliers`
+// (0-based sample indices of y).
 std::vector<double> PeriodicAverage(const std::vector<double>& y, std::size_t first, int samples_per_period,
-                                    int periods);
+                                    int periods, std::vector<std::size_t>* outliers = nullptr);
 
 // Eq. 26 on one period of uniformly sampled data starting at phase 0 (rectangle rule: exact for
 // harmonics below half the number of samples).
@@ -51,6 +54,7 @@ struct FrequencyPoint {
   double phase = 0.0;         // phi^ = -arg G^(j omega), wrapped to (-pi, pi] (unwrapped over a sweep)
   double fit_residual = 0.0;  // RMS misfit of harmonics 0..p relative to RMS of x^_N's harmonics
   std::vector<Harmonic> harmonics;
+  std::vector<std::size_t> outliers;  // samples left out of the periodic average (0-based)
 };
 
 // One frequency from the averaged period x^_N (eq. 23) and the stage-1 estimate of h.

@@ -7,6 +7,8 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
+#include "estimators/brouri/outliers.hpp"
 
 namespace hw::brouri {
 
@@ -19,23 +21,38 @@ std::vector<HoldAverage> AverageHolds(const std::vector<double>& y, const std::v
   if (y.size() < needed)
     throw InputError(fmt::format("recording has {} samples, the {} holds of {} samples need {}", y.size(),
                                  levels.size(), hold_samples, needed));
+  const std::size_t H = static_cast<std::size_t>(hold_samples), M = static_cast<std::size_t>(average_samples);
+  // Robust location and spread of each hold's settled part (its last M samples), and the data's scale.
+  std::vector<double> median(levels.size()), sigma(levels.size());
+  double lo = INFINITY, hi = -INFINITY, top = 0.0;
+  for (std::size_t j = 0; j < levels.size(); ++j) {
+    const std::vector<double> window(y.begin() + (j + 1) * H - M, y.begin() + (j + 1) * H);
+    median[j] = Median(window);
+    sigma[j] = RobustSigma(window);
+    lo = std::min(lo, median[j]), hi = std::max(hi, median[j]), top = std::max(top, std::abs(median[j]));
+  }
+  const double floor = kOutlierFloor * (top + hi - lo) + 1e-300;
   std::vector<HoldAverage> out;
   for (std::size_t j = 0; j < levels.size(); ++j) {
-    const std::size_t end = (j + 1) * static_cast<std::size_t>(hold_samples);
-    const std::size_t begin = end - static_cast<std::size_t>(average_samples);
-    double mean = 0.0;
-    for (std::size_t i = begin; i < end; ++i) mean += y[i];
-    mean /= average_samples;
-    double ss = 0.0;
-    for (std::size_t i = begin; i < end; ++i) ss += (y[i] - mean) * (y[i] - mean);
-    const double sd = std::sqrt(ss / (average_samples - 1));
-    HoldAverage h{levels[j], mean, sd / std::sqrt(static_cast<double>(average_samples)), average_samples};
-    const std::size_t first = end - static_cast<std::size_t>(hold_samples);
-    for (std::size_t i = first; i < end; ++i) h.hold_mean += y[i];
-    h.hold_mean /= hold_samples;
-    double hs = 0.0;
-    for (std::size_t i = first; i < end; ++i) hs += (y[i] - h.hold_mean) * (y[i] - h.hold_mean);
-    h.hold_std_error = std::sqrt(hs / (hold_samples - 1) / hold_samples);
+    const std::size_t first = j * H, end = first + H, begin = end - M;
+    HoldAverage h{levels[j], 0.0, 0.0, 0};
+    h.outliers = IsolatedOutliers(y, first, end, median[j], std::max(kOutlierSigmas * sigma[j], floor));
+    auto kept = [&](std::size_t i) { return !std::binary_search(h.outliers.begin(), h.outliers.end(), i); };
+    // Mean and standard error of the mean over the kept samples of [from, end).
+    auto mean_and_error = [&](std::size_t from, double* mean, double* error) {
+      double sum = 0.0, n = 0.0;
+      for (std::size_t i = from; i < end; ++i)
+        if (kept(i)) sum += y[i], n += 1;
+      *mean = sum / n;
+      double ss = 0.0;
+      for (std::size_t i = from; i < end; ++i)
+        if (kept(i)) ss += (y[i] - *mean) * (y[i] - *mean);
+      *error = std::sqrt(ss / std::max(1.0, n - 1) / n);
+      return static_cast<int>(n);
+    };
+    h.samples = mean_and_error(begin, &h.mean, &h.std_error);
+    mean_and_error(first, &h.hold_mean, &h.hold_std_error);
+    h.median = median[j];
     out.push_back(h);
   }
   return out;
@@ -71,6 +88,26 @@ DownBorderMethod DownBorderMethodFromString(const std::string& name) {
 }
 
 namespace {
+
+// "hold 7 (U = 0.4): sample 1235 (y = 1e+06) excluded as an isolated outlier ..." for every flagged hold.
+std::string OutlierWarnings(const HoldAverage& reset, const std::vector<HoldAverage>& up,
+                            const std::vector<HoldAverage>& down) {
+  std::string w;
+  std::vector<const HoldAverage*> holds = {&reset};
+  for (const auto* v : {&up, &down})
+    for (const auto& h : *v) holds.push_back(&h);
+  for (std::size_t j = 0; j < holds.size(); ++j) {
+    const auto& h = *holds[j];
+    if (h.outliers.empty()) continue;
+    std::string samples;
+    for (std::size_t i : h.outliers) samples += fmt::format("{}{}", samples.empty() ? "" : ", ", i + 1);
+    w += fmt::format("hold {} (U = {:g}): sample{} {} left out of the averages as isolated outlier{} (more than {:g} "
+                     "robust standard deviations from the hold's settled median {:.6g}). ",
+                     j, h.level, h.outliers.size() > 1 ? "s" : "", samples, h.outliers.size() > 1 ? "s" : "",
+                     kOutlierSigmas, h.median);
+  }
+  return w;
+}
 
 // Number of leading holds whose output equals the reference hold's (the plateau, eqs. 7a/14a). Each
 // candidate's whole-hold mean is compared with the pooled reference; accepted holds join the pool.
@@ -219,6 +256,7 @@ void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& 
   est->reset = reset;
   est->up = up;
   est->down = down;
+  est->warnings += OutlierWarnings(reset, up, down);
   est->j_a = PlateauLength(reset, up, options, scale);
   est->j_d = PlateauLength(up.back(), down, options, scale);
 
@@ -315,11 +353,17 @@ void EstimateNonlinearities(const NonlinearOptions& options, const HoldAverage& 
 namespace {
 nlohmann::json HoldJson(const HoldAverage& h) {
   return {{"level", h.level},         {"mean", h.mean},           {"std_error", h.std_error},
-          {"samples", h.samples},     {"hold_mean", h.hold_mean}, {"hold_std_error", h.hold_std_error}};
+          {"samples", h.samples},     {"hold_mean", h.hold_mean}, {"hold_std_error", h.hold_std_error},
+          {"median", h.median},       {"outliers", h.outliers}};
 }
 HoldAverage HoldFromJson(const nlohmann::json& j) {
-  return {j.at("level").get<double>(), j.at("mean").get<double>(), j.at("std_error").get<double>(),
-          j.at("samples").get<int>(), j.value("hold_mean", 0.0), j.value("hold_std_error", 0.0)};
+  CheckKeys(j, {"level", "mean", "std_error", "samples", "hold_mean", "hold_std_error", "median", "outliers"},
+            "nonlinear estimate: hold");
+  HoldAverage h{j.at("level").get<double>(), j.at("mean").get<double>(), j.at("std_error").get<double>(),
+                j.at("samples").get<int>(), j.value("hold_mean", 0.0), j.value("hold_std_error", 0.0)};
+  h.median = j.value("median", h.mean);
+  h.outliers = j.value("outliers", std::vector<std::size_t>{});
+  return h;
 }
 }  // namespace
 
@@ -352,8 +396,14 @@ nlohmann::json NonlinearEstimate::to_json() const {
   return j;
 }
 
-NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j) {
+NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j,
+                                                const std::vector<std::string_view>& extension_keys) {
   try {
+    std::vector<std::string_view> keys = {"operator", "degree", "j_a", "j_d", "params", "lines",
+                                          "descending_readings", "h", "joint_refit", "paper_lines", "q_up",
+                                          "q_down", "reset", "up", "down", "warnings"};
+    keys.insert(keys.end(), extension_keys.begin(), extension_keys.end());
+    CheckKeys(j, keys, "nonlinear estimate");
     NonlinearEstimate e;
     const auto op = j.at("operator").get<std::string>();
     if (op != "backlash" && op != "backlash-inverse")
@@ -363,6 +413,17 @@ NonlinearEstimate NonlinearEstimate::from_json(const nlohmann::json& j) {
     e.j_a = j.value("j_a", 0);
     e.j_d = j.value("j_d", 0);
     const auto& pj = j.at("params");
+    CheckKeys(pj, {"S_a", "d_plus", "S_d", "d_minus"}, "nonlinear estimate: params");
+    // Derived records (recomputed from params, not read) must still hold only their own keys.
+    for (const char* lines : {"lines", "paper_lines"})
+      if (j.contains(lines))
+        CheckKeys(j.at(lines), {"slope_up", "root_up", "slope_down", "root_down"}, std::string("nonlinear estimate: ") + lines);
+    if (j.contains("descending_readings")) {
+      const auto& r = j.at("descending_readings");
+      CheckKeys(r, {"paper_coefficients", "leading_and_root", "root_and_slope"}, "nonlinear estimate: descending_readings");
+      for (const auto& [name, reading] : r.items())
+        CheckKeys(reading, {"S_d", "d_minus"}, "nonlinear estimate: descending_readings: " + name);
+    }
     e.params = {pj.at("S_a").get<double>(), pj.at("d_plus").get<double>(), pj.at("S_d").get<double>(),
                 pj.at("d_minus").get<double>()};
     e.lines = LinesOf(e.kind, e.params);

@@ -27,6 +27,7 @@
 // A backlash-inverse input (eq. 2) has no plateau (j_a = j_d = 0) and its "up" line lies LEFT of its
 // "down" line; the estimator reads the operator kind from that order, it is not told.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -35,7 +36,8 @@
 
 namespace hw::brouri {
 
-// Eq. 9 on one hold: mean of its last `average_samples` samples, and the standard error of that mean.
+// Eq. 9 on one hold: mean of its last `average_samples` samples, and the standard error of that mean; isolated
+// outliers are left out and listed.
 struct HoldAverage {
   double level = 0.0;   // U_j
   double mean = 0.0;    // X^_j(M)
@@ -44,6 +46,10 @@ struct HoldAverage {
   // Over the WHOLE hold: on a plateau v does not move, so y is flat from the hold's first sample and
   // all of it can be compared with the reference; this gives the plateau test far more samples than M.
   double hold_mean = 0.0, hold_std_error = 0.0;
+  // Isolated outliers (estimators/brouri/outliers.hpp) left out of both averages: 0-based sample indices of
+  // the recording, ascending; and the median of the settled part they were judged against.
+  std::vector<std::size_t> outliers;
+  double median = 0.0;
 };
 // Holds are consecutive blocks of `hold_samples` samples of y starting at sample 0.
 std::vector<HoldAverage> AverageHolds(const std::vector<double>& y, const std::vector<double>& levels,
@@ -84,7 +90,9 @@ struct NonlinearEstimate {
   std::string warnings;
 
   nlohmann::json to_json() const;
-  static NonlinearEstimate from_json(const nlohmann::json& j);  // throws InputError
+  // Throws InputError, also for an unknown key; `extension_keys` are keys of an enclosing record the caller
+  // reads itself (the stage-1 result file adds "stage" and "summary").
+  static NonlinearEstimate from_json(const nlohmann::json& j, const std::vector<std::string_view>& extension_keys = {});
   // The pre-compensator of Fig. 8 that cancels the estimated operator (see the .cpp for the
   // backlash-inverse plant, where the paper's Lemma 1 overstates what a backlash can do).
   MemoryOperator Precompensator() const;

@@ -10,6 +10,7 @@
 #include <unsupported/Eigen/Polynomials>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 
 namespace hw::brouri {
 
@@ -222,10 +223,11 @@ nlohmann::json BacklashHwSystem::to_json() const {
 }
 
 BacklashHwSystem BacklashHwSystem::from_json(const nlohmann::json& j) {
-  const auto op = j.value("operator", std::string("backlash"));
-  if (op != "backlash" && op != "backlash-inverse")
-    throw InputError(fmt::format("system JSON: operator '{}' must be 'backlash' or 'backlash-inverse'", op));
+  CheckKeys(j, {"operator", "S_a", "d_plus", "S_d", "d_minus", "num", "den", "h", "noise_std"}, "system JSON");
   return ParseValidated<BacklashHwSystem>("system", [&] {
+    const auto op = j.value("operator", std::string("backlash"));
+    if (op != "backlash" && op != "backlash-inverse")
+      throw InputError(fmt::format("system JSON: operator '{}' must be 'backlash' or 'backlash-inverse'", op));
     BacklashHwSystem s;
     s.kind = op == "backlash" ? OperatorKind::kBacklash : OperatorKind::kBacklashInverse;
     s.backlash = {j.at("S_a").get<double>(), j.at("d_plus").get<double>(), j.at("S_d").get<double>(),

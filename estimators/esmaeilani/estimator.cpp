@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "core/json_input.hpp"
 
 namespace hw::esmaeilani {
 namespace {
@@ -86,9 +87,7 @@ void RequirePinned(const FunctionConstraints& c, const std::string& name, const 
 FunctionConstraints FunctionFromJson(const nlohmann::json& j, const std::string& where) {
   FunctionConstraints c;
   if (!j.is_object()) throw InputError(where + ": expected an object with range, slopes, points");
-  for (const auto& [key, value] : j.items())
-    if (key != "range" && key != "slopes" && key != "points")
-      throw InputError(fmt::format("{}: unknown key '{}'; expected range, slopes, points", where, key));
+  CheckKeys(j, {"range", "slopes", "points"}, where);
   if (j.contains("range")) {
     const auto r = j.at("range").get<std::vector<double>>();
     if (r.size() != 2) throw InputError(where + ".range: expected [lower, upper]");
@@ -97,6 +96,7 @@ FunctionConstraints FunctionFromJson(const nlohmann::json& j, const std::string&
     c.range_upper = r[1];
   }
   for (const auto& s : j.value("slopes", nlohmann::json::array())) {
+    CheckKeys(s, {"from", "to", "min", "max"}, where + ".slopes[]");
     FunctionConstraints::Slope sl{-kInf, kInf, -kInf, kInf};
     sl.from = s.value("from", -kInf);
     sl.to = s.value("to", kInf);
@@ -288,11 +288,8 @@ Constraints Constraints::FromJson(const nlohmann::json& j, const std::string& so
   Constraints c;
   try {
     if (!j.is_object()) throw InputError(source + ": constraints must be a JSON object");
-    for (const auto& [key, value] : j.items())
-      if (key != "f" && key != "g_inverse" && key != "d" && key != "output_range" && key != "saturation_tolerance" &&
-          key != "comment")
-        throw InputError(fmt::format(
-            "{}: unknown key '{}'; expected f, g_inverse, d, output_range, saturation_tolerance, comment", source, key));
+    CheckKeys(j, {"f", "g_inverse", "d", "output_range", "saturation_tolerance", "comment"}, source);
+    if (j.contains("comment") && !j.at("comment").is_string()) throw InputError(source + ": comment must be a string");
     if (j.contains("f")) c.f = FunctionFromJson(j.at("f"), source + ": f");
     if (j.contains("g_inverse")) c.g_inverse = FunctionFromJson(j.at("g_inverse"), source + ": g_inverse");
     if (j.contains("d")) {
@@ -317,22 +314,16 @@ Constraints Constraints::FromJson(const nlohmann::json& j, const std::string& so
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: {}", source, e.what()));
   }
-  CheckFunctionConstraints(c.f, "f");
-  CheckFunctionConstraints(c.g_inverse, "g_inverse");
+  try {
+    CheckFunctionConstraints(c.f, "f");
+    CheckFunctionConstraints(c.g_inverse, "g_inverse");
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", source, e.what()));
+  }
   return c;
 }
 
-Constraints Constraints::Load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open constraints file", path));
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
-  }
-  return FromJson(j, path);
-}
+Constraints Constraints::Load(const std::string& path) { return FromJson(ReadJsonFile(path, "constraints JSON file"), path); }
 
 nlohmann::json Constraints::ToJson() const {
   nlohmann::json j = {{"f", FunctionToJson(f)}, {"g_inverse", FunctionToJson(g_inverse)}};

@@ -1,0 +1,38 @@
+#pragma once
+// The size of a moment relaxation, computed from counts alone (no monomial basis is built), so that a
+// relaxation that cannot fit in memory is refused with its numbers before any allocation.
+//
+// Memory model (bytes, doubles of 8 bytes): the interior-point backends (CSDP, SDPA) form and factor the
+// dense Schur complement of the m free moments, 8 m^2; they keep about ten dense copies of every PSD block
+// (X, Z, their steps and work space), 80 sum b^2; the equality elimination holds one dense row of m per
+// equality row, 8 m r. The estimate is a lower bound of what a solve needs, good to the order of magnitude.
+#include <string>
+#include <vector>
+
+#include "relax/moment_relaxation.hpp"
+
+namespace hw::relax {
+
+struct RelaxationSize {
+  int num_vars = 0, order = 0;
+  double moments = 0;       // free moment variables m = C(n + 2 delta, n) - 1
+  double moment_block = 0;  // C(n + delta, n)
+  std::vector<double> localizing_blocks;  // PSD localizing blocks (one per inequality of order >= 1)
+  double scalar_rows = 0;   // localizers of order 0, gathered into one diagonal block
+  double equality_rows = 0;
+  double bytes = 0;         // the memory model above
+  std::string describe() const;  // "N moments, moment matrix S x S, K localizing blocks up to B, ~X GB"
+};
+
+// From the number of variables and the degrees of the inequalities (box constraints included, degree 2 each)
+// and of the equalities.
+RelaxationSize EstimateRelaxationSize(int num_vars, int order, const std::vector<int>& inequality_degrees,
+                                      const std::vector<int>& equality_degrees);
+RelaxationSize EstimateRelaxationSize(const PolyProblem& problem, int order);
+
+// Memory the system reports available now (MemAvailable of /proc/meminfo; physical memory when absent).
+double AvailableMemoryBytes();
+// "1.5 GB", "320 MB", "2.1e+12 GB".
+std::string FormatBytes(double bytes);
+
+}  // namespace hw::relax
