@@ -86,7 +86,7 @@ TEST(ReadableOutputs, SummaryTablesEscapeBars) {
       {"applicable", true}, {"runs_ok", 1}, {"failures", nlohmann::json::array()},
       {"quantities", {{"freq_max_error", {{"n", 1}, {"mean", 0.1}, {"std", 0.0}, {"worst", 0.1}}}}}};
   s["methods"]["setmembership"] = {{"applicable", false}, {"reason", "a |reason| with bars"}};
-  const std::string md = SummaryMarkdown(s);
+  const std::string md = compare::SummaryMarkdown(s);
   EXPECT_TRUE(Has(md, "normalised \\|G\\| max error")) << md;
   ExpectWellFormedTables(md);
 }
