@@ -272,8 +272,9 @@ void AddBoundsCommand(CLI::App& app) {
   auto* noise_col =
       cmd->add_option("--noise-col", o->noise_col, "column with a per-sample noise bound (instead of --noise-bound)");
   noise_bound->excludes(noise_col);
-  cmd->add_option("--na", o->na, "denominator order")->check(CLI::Range(1, 20));
-  cmd->add_option("--nb", o->nb, "numerator order (b_0..b_nb, b_0 = 0 unless --proper)")->check(CLI::Range(0, 20));
+  // --na, --nb: checked by HwStructure::IsValid (the same message as the Python module's).
+  cmd->add_option("--na", o->na, "denominator order");
+  cmd->add_option("--nb", o->nb, "numerator order (b_0..b_nb, b_0 = 0 unless --proper)");
   cmd->add_flag("--proper", o->proper, "estimate b_0 too (proper, not strictly proper)");
   cmd->add_option("--input-basis", o->input_basis, "psi basis: poly:K or a list like 'w,w^3,tanh'");
   cmd->add_option("--output-basis", o->output_basis, "phi basis of the inverse output map");
@@ -283,8 +284,8 @@ void AddBoundsCommand(CLI::App& app) {
       ->default_str("minimal");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
   cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
-  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)")
-      ->check(CLI::Range(0, 4096));
+  // Checked by BoundsOptions::IsValid, so that the CLI and the Python module give the same message.
+  cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)");
   cmd->add_option("--executor", o->executor,
                   "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "
                   "coordinates, the other ranks solve)")

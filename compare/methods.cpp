@@ -80,7 +80,8 @@ void DiscreteQuantities(const Scenario& s, const Plant& truth, const Plant& est,
     mx = std::max(mx, std::abs(ge - gt));
     ss += (ge - gt) * (ge - gt);
   }
-  if (std::isfinite(mx)) {
+  // std::max drops NaN, so the sum is what shows an undefined response (e.g. a midpoint model with b = 0).
+  if (std::isfinite(mx) && std::isfinite(ss)) {
     q["freq_max_error"] = mx;
     q["freq_rms_error"] = std::sqrt(ss / w.size());
     curves["omega"] = w;

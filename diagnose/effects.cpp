@@ -294,7 +294,7 @@ AugmentedModel AugmentedModel::from_json(const nlohmann::json& j) {
   AugmentedModel m;
   nlohmann::json base = j;
   base["type"] = "hammerstein_wiener";
-  m.nominal = HwModel::from_json(base);
+  m.nominal = HwModel::from_json(base, {"output_offset", "effect_block"});  // the keys an augmented model adds
   if (j.contains("output_offset") && j["output_offset"].is_number()) m.output_offset = j["output_offset"].get<double>();
   if (j.contains("effect_block")) {
     try {

@@ -104,6 +104,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   const auto summary = WithoutGil([&] { return relax::ComputeBounds(a.options, set, report); });
   nlohmann::json j = summary.to_json();
   j["data"] = source;
+  j["data_warnings"] = set.warnings();  // as the CLI writes them
   j["structure"] = {{"na", a.structure.na},
                     {"nb", a.structure.nb},
                     {"proper", !a.structure.strictly_proper},

@@ -198,7 +198,9 @@ TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth
       ++checked;
     }
   }
-  EXPECT_GE(checked, 8);
+  // 6 at least: with b's intervals equal to the (symmetric) prior box the set-membership midpoint model has
+  // G(1) = 0, so its normalised frequency response is reported not available rather than as numbers.
+  EXPECT_GE(checked, 6);
   // Time per method equals the per-run times.
   double total = 0.0;
   for (const auto& run : runs) total += run["methods"]["esmaeilani"]["seconds"].get<double>();

@@ -89,30 +89,6 @@ TEST(SetMembership, SameEndpointsWhateverTheNumberOfWorkers) {
     }
 }
 
-TEST(SetMembership, DataOutsideTheModelClassInvalidateTheModel) {
-  // A recording the model class cannot explain: an output that jumps at random between +-1 with a tiny noise
-  // bound. Every orthant must be proven empty (verified), and the summary says so instead of giving intervals.
-  const auto ex = SimulateCeroneExample(5, 40, 31.0);
-  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), 1e-4), "outside the model class"};
-  for (std::size_t t = 0; t < data.y.size(); ++t) data.y[t] = (t * 7919 % 13) % 2 ? 1.0 : -1.0;
-  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
-  BoundsOptions options;
-  options.order = 1;
-  options.threads = 2;
-  options.retry_with_other_solver = false;
-  const auto s = ComputeBounds(options, set);
-  EXPECT_TRUE(s.invalidated());
-  EXPECT_EQ(s.orthants_empty, s.orthants_total);
-  const auto j = s.to_json();
-  EXPECT_TRUE(j.at("invalidated").get<bool>());
-  EXPECT_TRUE(j.at("intervals").at(0).at("lower").at("value").is_null());
-  // Consistent data are never called invalidated.
-  HwData good{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  const auto ok = ComputeBounds(options, HwOuterSet(CeroneExampleStructure(), good, 1,
-                                                    std::vector<std::pair<double, double>>(8, {-10.0, 10.0})));
-  EXPECT_FALSE(ok.invalidated());
-}
-
 TEST(SetMembership, UnknownParameterNameIsAnError) {
   EXPECT_THROW(RunBounds(1, 40, 1, 1, 31.0, "sdpa", {"a7"}), InputError);
 }

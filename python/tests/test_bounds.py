@@ -62,7 +62,7 @@ def test_validation_errors_carry_the_cli_message(recording):
     assert str(e.value) == "na must be >= 1" == cli_error(*args, "--na", 0)
     with pytest.raises(ValueError) as e:
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, solver="mosek")
-    assert str(e.value) == "bounds options: solver 'mosek' unknown; expected csdp or sdpa"
+    assert str(e.value) == "bounds options: solver 'mosek' unknown; expected csdp, sdpa or dsdp"
     with pytest.raises(ValueError, match=r"^bounds options: order must be >= 1$"):
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=0)
     with pytest.raises(ValueError, match=r"^noise_bound must be a positive number \(got 0\), or one bound per sample$"):
