@@ -120,7 +120,7 @@ TEST(DsdpBackend, InfeasibleLmiIsCertifiedAndVerified) {
 }
 
 // min -y1 - y2  s.t.  [[y1, 1], [1, y2]] >= 0: y1 = y2 -> infinity stays feasible.
-TEST(DsdpBackend, UnboundedObjectiveIsCertifiedByTheRay) {
+LmiProblem UnboundedAlongTheDiagonal() {
   LmiProblem p;
   p.blocks = {{Kind::kPsd, 2}};
   p.c = {-1.0, -1.0};
@@ -128,6 +128,11 @@ TEST(DsdpBackend, UnboundedObjectiveIsCertifiedByTheRay) {
   p.add(1, 0, 0, 0, 1.0);
   p.add(2, 0, 1, 1, 1.0);
   p.add(0, 0, 0, 1, -1.0);
+  return p;
+}
+
+TEST(DsdpBackend, UnboundedObjectiveIsCertifiedByTheRay) {
+  const auto p = UnboundedAlongTheDiagonal();
   const auto s = SolveWith("dsdp", p);
   ASSERT_EQ(s.status, SdpStatus::kUnbounded) << s.message;
   EXPECT_EQ(s.lower_bound, -INFINITY);
@@ -265,13 +270,6 @@ TEST(DsdpBackend, VerbosePrintsTheIterationLog) {
 
 // Nothing on stdout without verbose, whatever the outcome (DSDP prints only tracebacks of failed calls).
 TEST(DsdpBackend, QuietOnEveryOutcome) {
-  LmiProblem unbounded;
-  unbounded.blocks = {{Kind::kPsd, 2}};
-  unbounded.c = {-1.0, -1.0};
-  unbounded.F.resize(3);
-  unbounded.add(1, 0, 0, 0, 1.0);
-  unbounded.add(2, 0, 1, 1, 1.0);
-  unbounded.add(0, 0, 0, 1, -1.0);
   // min x1^4 + x2^2 on the line x1 + x2 = 1, order 3: no interior, DSDP breaks down (indefinite Schur matrix).
   const std::vector<std::string> v = {"x1", "x2"};
   relax::PolyProblem line;
@@ -284,7 +282,7 @@ TEST(DsdpBackend, QuietOnEveryOutcome) {
   capped.max_iterations = 2;
   testing::internal::CaptureStdout();
   const auto a = SolveWith("dsdp", InfeasibleMixedLmi());
-  const auto b = SolveWith("dsdp", unbounded);
+  const auto b = SolveWith("dsdp", UnboundedAlongTheDiagonal());
   const auto c = SolveWith("dsdp", MaxEigenvalueInABox(3, 5, 3), capped);
   const auto d = SolveWith("dsdp", no_interior.lmi());
   const std::string printed = testing::internal::GetCapturedStdout();
