@@ -49,11 +49,17 @@ double EstimateNoiseStd(const std::vector<double>& e, std::size_t skip) {
 }
 
 bool WindowOptions::IsValid(std::string* error) const {
-  if (length < 0 || length == 1 || !(z > 0)) {
-    if (error) *error = "window length must be 0 (auto) or >= 2, and z > 0";
+  if (length < 0 || length == 1 || !(alpha > 0 && alpha < 1)) {
+    if (error) *error = "window length must be 0 (auto) or >= 2, and alpha in (0, 1)";
     return false;
   }
   return true;
+}
+
+double WindowOptions::Threshold(std::size_t n) const {
+  const int L = Resolve(n);
+  const double windows = std::max(1.0, static_cast<double>(n) / L);
+  return ChiSquareQuantile(1.0 - alpha / windows, L) / L;
 }
 
 int WindowOptions::Resolve(std::size_t n) const {
@@ -66,7 +72,7 @@ std::vector<bool> MismatchMask(const std::vector<double>& e, double sigma, std::
   const int L = o.Resolve(n);
   std::vector<bool> mask(n, false);
   if (n < skip + L || !(sigma > 0)) return mask;
-  const double thr = sigma * sigma * (1.0 + o.z * std::sqrt(2.0 / L));
+  const double thr = sigma * sigma * o.Threshold(n - skip);
   std::vector<double> cs(n + 1, 0.0);
   for (std::size_t t = 0; t < n; ++t) cs[t + 1] = cs[t] + (t >= skip ? e[t] * e[t] : 0.0);
   for (std::size_t s = skip; s + L <= n; ++s) {

@@ -16,9 +16,13 @@ double EstimateNoiseStd(const std::vector<double>& e, std::size_t skip);
 
 struct WindowOptions {
   int length = 0;           // sliding-window length in samples; 0 = auto (N/200 clamped to [8, 40])
-  double z = 3.0;           // local mean square must exceed sigma^2 (1 + z sqrt(2/L))
+  // Family-wise false-alarm probability over the recording's N/L disjoint windows: a window is flagged
+  // when its mean square exceeds sigma^2 chi^2_L(1 - alpha L / N) / L (Bonferroni), so that a recording
+  // the model explains is flagged nowhere with probability about 1 - alpha.
+  double alpha = 0.05;
   bool IsValid(std::string* error) const;
   int Resolve(std::size_t n) const;
+  double Threshold(std::size_t n) const;  // in units of sigma^2
 };
 
 // Samples (mask) and merged [start, end] index windows where the local mean-square error exceeds the noise.
