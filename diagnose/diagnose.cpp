@@ -74,15 +74,9 @@ void ParallelFor(std::size_t n, int threads, F f) {
   for (auto& t : pool) t.join();
 }
 
-std::string ParamText(const std::vector<EffectBlock>& blocks) {
+std::string ParamText(const AugmentedModel& m) {
   std::string s;
-  for (const auto& b : blocks) {
-    const auto names = ParameterNames(b.effect);
-    std::string p;
-    for (std::size_t i = 0; i < names.size() && i < b.params.size(); ++i)
-      p += fmt::format("{}{} = {:.4g}", p.empty() ? "" : ", ", names[i], b.params[i]);
-    s += fmt::format("{}{} ({})", s.empty() ? "" : " + ", b.Label(), p);
-  }
+  for (const auto& b : m.blocks) s += fmt::format("{}{} ({})", s.empty() ? "" : " + ", b.Label(), ParameterText(b, m));
   return s;
 }
 
@@ -136,19 +130,32 @@ struct Reference {
 };
 
 Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
-  const RefitResult fit = AddBlock(ref.fitted, effect, location, c.o.state_variable, c.fit, c.o.refit);
+  // Saturation-type blocks: one-sided and two-sided limits are different structures, chosen by the
+  // penalised held-out score (a second limit must earn its parameter).
+  std::vector<LimitSides> variants = {LimitSides::kAny};
+  if (effect == Effect::kSaturation || effect == Effect::kStateSaturation)
+    variants = {LimitSides::kUpper, LimitSides::kLower, LimitSides::kBoth};
   Finding f;
-  f.fitted = fit.model;
-  f.blocks = fit.model.blocks;
-  f.extra_parameters = fit.extra_parameters - EffectParameterCount(ref.fitted);
-  const Vec e1 = c.IdentResidual(fit.model);
-  f.holdout = c.Compare(ref.ident_residual, e1, c.nfit, c.n, f.extra_parameters, c.o.significance_z);
-  f.model = RefitModel(fit.model, c.full, c.o.refit).model;
+  bool have = false;
+  for (const LimitSides sides : variants) {
+    const RefitResult fit = AddBlock(ref.fitted, effect, location, c.o.state_variable, c.fit, c.o.refit, sides);
+    if (fit.model.blocks.size() <= ref.fitted.blocks.size()) continue;
+    const int k = fit.extra_parameters - EffectParameterCount(ref.fitted);
+    const Comparison h = c.Compare(ref.ident_residual, c.IdentResidual(fit.model), c.nfit, c.n, k, c.o.significance_z);
+    if (have && h.score <= f.holdout.score) continue;
+    have = true;
+    f.fitted = fit.model;
+    f.blocks = fit.model.blocks;
+    f.extra_parameters = k;
+    f.holdout = h;
+  }
+  if (!have) return f;
+  f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
   const Vec v1 = c.ValidationResidual(f.model);
   f.validation = c.Compare(ref.valid_residual, v1, c.skip, c.nv, f.extra_parameters, c.o.validation_z);
   const double ph = std::max(1.0 - f.holdout.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
   f.score = 1.0 - std::sqrt(ph * pv);
-  f.eligible = fit.model.blocks.size() > ref.fitted.blocks.size() && f.holdout.significant && f.validation.significant;
+  f.eligible = f.holdout.significant && f.validation.significant;
   return f;
 }
 
@@ -164,7 +171,7 @@ std::string Evidence(const Finding& f) {
       "held-out MSE {:.3g}x the baseline's (penalised reduction {:.1f} %, z = {:.1f}); validation MSE {:.3g}x "
       "(penalised reduction {:.1f} %, z = {:.1f}){}; {}",
       f.holdout.ratio, 100 * f.holdout.score, f.holdout.z, f.validation.ratio, 100 * f.validation.score,
-      f.validation.z, f.eligible ? "; eligible" : "; not significant on both", ParamText(f.blocks));
+      f.validation.z, f.eligible ? "; eligible" : "; not significant on both", ParamText(f.model));
 }
 
 // Baseline: the nominal refitted alone, from the given numbers and (structure known) fresh starts.
@@ -258,6 +265,12 @@ void Summarise(DiagnoseReport* rp) {
   std::size_t flagged = 0;
   for (bool m : r.mask) flagged += m;
   const double frac = r.mask.empty() ? 0.0 : double(flagged) / r.mask.size();
+  std::string per_block;
+  if (r.block_windows.size() > 1) {
+    for (const auto& w : r.block_windows)
+      per_block += fmt::format("{}{} acts in {:.1f} %", per_block.empty() ? " On its own: " : "; ", w.label, 100 * w.fraction);
+    per_block += " of the samples.";
+  }
   if (r.verdict == Effect::kNone)
     r.message = fmt::format("verdict: none — {}. Validation RMSE {:.4g} (fit {:.1f} %) for the refitted nominal "
                             "model; {:.1f} % of the identification samples flagged ({}).",
@@ -267,9 +280,9 @@ void Summarise(DiagnoseReport* rp) {
     r.message = fmt::format(
         "verdict: {} ({}). Where: {} window(s), {:.1f} % of the identification samples, {}. Validation RMSE {:.4g} "
         "-> {:.4g} (fit {:.1f} % -> {:.1f} %).",
-        r.augmented_model.Label(), ParamText(r.verdict_blocks), r.windows.size(), 100 * frac, r.region.description,
+        r.augmented_model.Label(), ParamText(r.augmented_model), r.windows.size(), 100 * frac, r.region.description,
         r.nominal_refit.rmse, r.augmented.rmse, r.nominal_refit.fit_percent, r.augmented.fit_percent) +
-        param_note;
+        per_block + param_note;
 }
 
 }  // namespace
@@ -407,6 +420,7 @@ void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const Nom
   Vec weight;
   if (verdict) {
     r.mask = BlockEffectMask(r.augmented_model, ident.u, sigma, skip, &weight);
+    r.block_windows = PerBlockMasks(r.augmented_model, ident.u, sigma, skip);
     r.mask_source = "samples where the verdict's blocks change the prediction by more than the noise";
     r.validation_windows = MaskToWindows(BlockEffectMask(r.augmented_model, valid.u, sigma, skip, nullptr));
   } else {
@@ -416,7 +430,7 @@ void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const Nom
     r.validation_windows = MaskToWindows(MismatchMask(v_refit, sigma, skip, o.windows));
   }
   r.windows = MaskToWindows(r.mask);
-  r.region = CharacteriseRegion(r.conditions, r.mask, weight, skip);
+  r.region = CharacteriseRegion(r.conditions, r.mask, weight, skip, verdict ? "change" : "error");
   for (auto& f : r.findings) f.in_window_share = ImprovementShareIn(r.residual_mask, base.ident_residual,
                                                                       c.IdentResidual(f.fitted), c.nfit, n);
   r.initial_state_note = InitialStateNote(r.nominal_refit_model, ident.u, sigma);

@@ -30,6 +30,7 @@
 
 #include "core/hw_model.hpp"
 #include "diagnose/effects.hpp"
+#include "diagnose/locate.hpp"
 #include "diagnose/nominal_fit.hpp"
 #include "diagnose/recording.hpp"
 #include "diagnose/refit.hpp"
@@ -105,6 +106,7 @@ struct DiagnoseReport {
   std::vector<std::pair<std::size_t, std::size_t>> windows;
   std::vector<std::pair<std::size_t, std::size_t>> validation_windows;
   std::vector<bool> residual_mask;          // nominal residual beyond the noise (for the figures)
+  std::vector<BlockWindows> block_windows;  // where each verdict block (each limit) acts on its own
   Region region;
   CorrelationTest whiteness_nominal, input_corr_nominal, whiteness_augmented, input_corr_augmented;
   double validation_z = 0.0;

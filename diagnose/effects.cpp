@@ -342,6 +342,34 @@ std::vector<double> ApplyInputBlock(const EffectBlock& block, const std::vector<
   return x;
 }
 
+std::vector<double> ParametersInRecordingUnits(const EffectBlock& b, const AugmentedModel& m) {
+  std::vector<double> p = b.params;
+  if (b.effect == Effect::kStateSaturation && b.location == Location::kState)
+    for (auto& v : p)
+      if (std::isfinite(v)) v = m.nominal.output(v) + m.output_offset;
+  return p;
+}
+
+std::vector<double> FrictionLevelsInInputUnits(const EffectBlock& b, const AugmentedModel& m) {
+  if (b.effect != Effect::kCoulombFriction || m.nominal.input.kind != StaticMap::Kind::kIdentity) return {};
+  double gain = 0.0;
+  for (double v : m.nominal.linear.b) gain += v;
+  if (!(std::abs(gain) > 0)) return {};
+  return {b.params[0] / std::abs(gain), b.params[1] / std::abs(gain)};
+}
+
+std::string ParameterText(const EffectBlock& b, const AugmentedModel& m) {
+  const auto names = ParameterNames(b.effect);
+  const auto p = ParametersInRecordingUnits(b, m);
+  const auto force = FrictionLevelsInInputUnits(b, m);
+  std::string s;
+  for (std::size_t i = 0; i < names.size() && i < p.size(); ++i) {
+    s += fmt::format("{}{} = {:.4g}", s.empty() ? "" : ", ", names[i], p[i]);
+    if (i < force.size()) s += fmt::format(" ({:.4g} in input units)", force[i]);
+  }
+  return s;
+}
+
 std::string AugmentedModel::Label() const {
   if (blocks.empty()) return "none";
   std::string s;

@@ -110,6 +110,15 @@ struct AugmentedModel {
   static AugmentedModel Load(const std::string& path);  // errors name the file
 };
 
+// A block's parameters in the recording's units: a state saturation's limits act on z, which the output
+// map and the offset turn into the recorded value; every other block's parameters are already in the
+// units of the signal it acts on (u for input blocks, the recorded y for output blocks).
+std::vector<double> ParametersInRecordingUnits(const EffectBlock& block, const AugmentedModel& model);
+std::string ParameterText(const EffectBlock& block, const AugmentedModel& model);  // "lower = 3, upper = 9.95"
+// Coulomb friction levels as forces in the input's units: a level is a velocity change per step, the
+// input moves the velocity by sum(b) per unit per step (identity input map). Empty for other blocks.
+std::vector<double> FrictionLevelsInInputUnits(const EffectBlock& block, const AugmentedModel& model);
+
 // Applies a memoryful or static input-location block to a signal (exposed for tests and the generator).
 std::vector<double> ApplyInputBlock(const EffectBlock& block, const std::vector<double>& u);
 double ApplyStaticBlock(const EffectBlock& block, double v);  // deadzone, saturation, quantization

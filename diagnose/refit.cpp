@@ -452,7 +452,7 @@ RefitResult RefitModel(const AugmentedModel& model, const Segment& s, const Refi
 }
 
 RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location location, StateVariable sv, const Segment& s,
-                     const RefitOptions& o) {
+                     const RefitOptions& o, LimitSides sides) {
   if (effect == Effect::kNone || base.blocks.size() >= 2) return RefitModel(base, s, o);
   const Vec& u = *s.u;
   // The signal the block acts on, from the current model: the state for state blocks.
@@ -473,7 +473,22 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   const auto grid = EffectGrid(effect, location, location == Location::kInput ? input : u,
                                location == Location::kOutput ? yhat : *s.y, zhat, base.nominal);
   std::vector<std::pair<double, AugmentedModel>> scored;
+  auto wanted = [&](const Vec& p) {
+    if (p.size() != 2 || (effect != Effect::kSaturation && effect != Effect::kStateSaturation)) return true;
+    const bool lo = std::isfinite(p[0]), hi = std::isfinite(p[1]);
+    switch (sides) {
+      case LimitSides::kUpper:
+        return hi && !lo;
+      case LimitSides::kLower:
+        return lo && !hi;
+      case LimitSides::kBoth:
+        return lo && hi;
+      default:
+        return true;
+    }
+  };
   for (const auto& p : grid) {
+    if (!wanted(p)) continue;
     AugmentedModel m = base;
     EffectBlock b{effect, location, p, sv};
     std::string err;

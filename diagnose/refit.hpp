@@ -66,11 +66,14 @@ struct RefitResult {
 
 // Jointly refits every number of `model` (linear block, maps, offset, initial state, block parameters).
 RefitResult RefitModel(const AugmentedModel& model, const Segment& data, const RefitOptions& options);
+// Which limits of a saturation-type block are estimated (the others stay infinite).
+enum class LimitSides { kAny, kUpper, kLower, kBoth };
+
 // Adds one effect block to `base` (which may already hold one) and refits jointly; a grid over the new
 // block's parameters seeds the optimiser. Returns `base` refitted without the block (extra_parameters
 // 0) when no grid point is admissible.
 RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location location, StateVariable state_variable,
-                     const Segment& data, const RefitOptions& options);
+                     const Segment& data, const RefitOptions& options, LimitSides sides = LimitSides::kAny);
 // Re-estimates only the initial state (and nothing else) of `model` on a recording, e.g. to compare
 // fixed models on a validation recording that does not start from rest. No-op when the linear block
 // has no poles or when `options.estimate_initial_state` is false.

@@ -35,28 +35,19 @@ std::string Verdict(const DiagnoseReport& r) {
 nlohmann::json BlockJson(const EffectBlock& b, const AugmentedModel& m) {
   nlohmann::json j = b.to_json();
   if (b.effect == Effect::kStateSaturation) {
-    nlohmann::json p = nlohmann::json::object();
-    const char* names[] = {"lower", "upper"};
-    for (int i = 0; i < 2; ++i) {
-      const double v = b.params[i];
-      if (std::isfinite(v))
-        p[names[i]] = m.nominal.output(v) + m.output_offset;
-      else
-        p[names[i]] = v > 0 ? "inf" : "-inf";
-    }
-    j["parameters_in_recording_units"] = p;
+    EffectBlock in_units = b;
+    in_units.params = ParametersInRecordingUnits(b, m);
+    j["parameters_in_recording_units"] = in_units.to_json()["parameters"];
   }
+  const auto force = FrictionLevelsInInputUnits(b, m);
+  if (!force.empty()) j["levels_in_input_units"] = {{"level_up", force[0]}, {"level_down", force[1]}};
   return j;
 }
 
 std::string ParamTextOf(const Finding& f) {
   std::string s;
-  for (const auto& b : f.model.blocks) {
-    std::string p;
-    const auto names = ParameterNames(b.effect);
-    for (std::size_t i = 0; i < names.size(); ++i) p += fmt::format("{}{}={:.4g}", i ? ", " : "", names[i], b.params[i]);
-    s += fmt::format("{}{} ({})", s.empty() ? "" : " + ", b.Label(), p);
-  }
+  for (const auto& b : f.model.blocks)
+    s += fmt::format("{}{} ({})", s.empty() ? "" : " + ", b.Label(), ParameterText(b, f.model));
   return s;
 }
 
@@ -141,6 +132,13 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
       {"flagged_fraction", r.mask.empty() ? 0.0 : double(flagged) / r.mask.size()},
       {"validation_windows", TimeWindows(r.validation_windows, valid.t)},
       {"nominal_residual_windows", SampleWindows(MaskToWindows(r.residual_mask))},
+      {"per_block", [&] {
+         nlohmann::json pb = nlohmann::json::array();
+         for (const auto& w : r.block_windows)
+           pb.push_back({{"label", w.label}, {"flagged_fraction", w.fraction},
+                         {"window_samples", SampleWindows(MaskToWindows(w.mask))}});
+         return pb;
+       }()},
       {"region", r.region.to_json()},
       {"noise_std", r.noise_std},
       {"noise_std_source", r.noise_estimated ? "estimated (1.4826 MAD of residual differences / sqrt 2, capped by the "

@@ -58,9 +58,10 @@ struct Region {
   nlohmann::json to_json() const;
 };
 // The single threshold rule on one condition that best matches the mismatch mask (F1), weighted by
-// the squared error so that a rule must also concentrate the error.
+// the squared signal e so that a rule must also concentrate it. `subject` names e in the text
+// ("error" for a residual, "change" for what an effect block changes in the prediction).
 Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::vector<bool>& mask,
-                          const std::vector<double>& e, std::size_t skip);
+                          const std::vector<double>& e, std::size_t skip, const std::string& subject = "error");
 
 struct CorrelationTest {
   double statistic = 0.0;  // N sum rho^2
