@@ -6,8 +6,9 @@
 // structure (as `--fit` would).
 // Writes OUT/diagnose_study.md and OUT/diagnose_study.json (confusion matrices, named-right rate,
 // false alarms, window IoU, validation fit gain).
-// Usage: diagnose_study [OUT_DIR] [SEEDS] [SAMPLES] [FIRST_SEED] [NOMINALS] [NULLS]
-//   defaults: diagnose_study_out 5 2000 1001 design,linear:2,2 10
+// Usage: diagnose_study [OUT_DIR] [SEEDS] [SAMPLES] [FIRST_SEED] [NOMINALS] [NULLS] [RATIOS]
+//   defaults: diagnose_study_out 5 2000 1001 design,linear:2,2 10 1,1.5,2,2.5,3
+// RATIOS (effect RMS / noise standard deviation) are cycled over the seeds.
 // The reported study uses seeds 1001.. ; development and tests/diagnose_study_test.cpp use seeds 1..99.
 #include <filesystem>
 #include <sstream>
@@ -51,8 +52,15 @@ int main(int argc, char** argv) {
   const unsigned first_seed = argc > 4 ? static_cast<unsigned>(std::stoul(argv[4])) : 1001;
   const auto nominals = SplitList(argc > 5 ? argv[5] : "design,linear:2,2");
   const int nulls = argc > 6 ? std::stoi(argv[6]) : 10;
-  std::string md = fmt::format("# Concealed-effect study of hwbounds diagnose\n\nCommand: `diagnose_study {} {} {} {} {} {}`\n\n",
-                               out, seeds, samples, first_seed, argc > 5 ? argv[5] : "design,linear:2,2", nulls);
+  const std::string ratio_text = argc > 7 ? argv[7] : "1,1.5,2,2.5,3";
+  std::vector<double> ratios;
+  {
+    std::istringstream in(ratio_text);
+    for (std::string tok; std::getline(in, tok, ',');) ratios.push_back(std::stod(tok));
+  }
+  std::string md = fmt::format("# Concealed-effect study of hwbounds diagnose\n\nCommand: `diagnose_study {} {} {} {} {} {} {}`\n\n",
+                               out, seeds, samples, first_seed, argc > 5 ? argv[5] : "design,linear:2,2", nulls,
+                               ratio_text);
   nlohmann::json js;
   double total = 0.0;
   for (const std::string& nominal : nominals) {
@@ -62,11 +70,14 @@ int main(int argc, char** argv) {
     o.samples = samples;
     o.first_seed = first_seed;
     o.nominal = nominal;
+    o.ratios = ratios;
     const StudyResult r = RunStudy(o);
     total += r.seconds;
-    md += fmt::format("## Nominal model: {}\n\n{} scenarios per effect and location (seeds {}–{}), {} null scenarios, "
-                      "{} samples per recording (identification and validation each).\n\n{}\n",
-                      Title(nominal), seeds, first_seed, first_seed + seeds - 1, nulls, samples, r.to_markdown());
+    md += fmt::format("## Nominal model: {}\n\n{} scenarios per effect and location (seeds {}–{}, effect RMS {} times "
+                      "the noise standard deviation), {} null scenarios, {} samples per recording (identification and "
+                      "validation each).\n\n{}\n",
+                      Title(nominal), seeds, first_seed, first_seed + seeds - 1, ratio_text, nulls, samples,
+                      r.to_markdown());
     std::string wrong;
     for (const auto& c : r.cases)
       if (c.truth != c.verdict || (c.truth != Effect::kNone && c.truth_location != c.verdict_location))

@@ -2,6 +2,7 @@
 // null cases with a nominal fitted by the tool, and recordings that do not start from rest.
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -76,6 +77,36 @@ TEST(Diagnose, RecordingsThatDoNotStartFromRest) {
   Diagnose(from_rest, truth, nullptr, ident, valid, &q);
   ASSERT_TRUE(q.ok) << q.message;
   EXPECT_GT(q.ident_nominal.rmse, 1.3 * sc.noise_std);
+}
+
+// Two effects at once (backlash on the actuator and a clipping sensor): one block does not explain the
+// data, the combination is named.
+TEST(Diagnose, TwoEffectsAreNamedAsACombination) {
+  ScenarioOptions so;
+  so.effect = Effect::kBacklash;
+  so.seed = 8;
+  so.samples = 1500;
+  so.effect_rms_ratio = 4.0;
+  const Scenario sc = MakeScenario(so);
+  AugmentedModel truth = sc.truth;
+  const auto clean = truth.simulate(sc.ident.u);
+  auto sorted = clean;
+  std::sort(sorted.begin(), sorted.end());
+  truth.blocks.push_back({Effect::kSaturation, Location::kOutput, {-HUGE_VAL, sorted[sorted.size() * 9 / 10]}});
+  std::mt19937_64 rng(2);
+  std::normal_distribution<double> g(0.0, sc.noise_std);
+  Recording ident = sc.ident, valid = sc.valid;
+  ident.y = truth.simulate(ident.u);
+  valid.y = truth.simulate(valid.u);
+  for (auto& v : ident.y) v += g(rng);
+  for (auto& v : valid.y) v += g(rng);
+  DiagnoseReport r;
+  Diagnose({}, AugmentedModel{sc.linear_truth, {}, 0.0, {}}, nullptr, ident, valid, &r);
+  ASSERT_TRUE(r.ok) << r.message;
+  const std::string label = r.augmented_model.Label();
+  EXPECT_EQ(r.verdict_blocks.size(), 2u) << r.message;
+  EXPECT_NE(label.find("backlash@input"), std::string::npos) << label;
+  EXPECT_NE(label.find("saturation@output"), std::string::npos) << label;
 }
 
 }  // namespace
