@@ -254,10 +254,11 @@ NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const Nomina
   NominalFit out;
   out.spec = spec.Text();
   using Tried = std::vector<std::pair<NominalStart, AugmentedModel>>;
+  // A start that ends with a map folding back over the data is not a physical nominal: not kept.
   auto attempt = [&](Tried* tried, const std::string& name, const AugmentedModel& start) {
     RefitResult r = RefitModel(start, fit, o.refit);
     const double f = Rmse(r.model, fit), h = Rmse(r.model, held);
-    if (std::isfinite(f) && std::isfinite(h)) tried->push_back({{name, f, h}, r.model});
+    if (std::isfinite(f) && std::isfinite(h) && MapsMonotone(r.model, *data.u)) tried->push_back({{name, f, h}, r.model});
   };
   auto best_of = [](const Tried& tried) {
     int best = -1;
@@ -292,7 +293,7 @@ NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const Nomina
     }
   }
   out.chosen = best_of(tried);
-  if (out.chosen < 0) throw InputError(fmt::format("nominal fit {}: no start gave a finite simulation", spec.Text()));
+  if (out.chosen < 0) throw InputError(fmt::format("nominal fit {}: no start gave a finite simulation with monotone maps", spec.Text()));
   for (const auto& t : tried) out.starts.push_back(t.first);
   out.model = RefitModel(tried[out.chosen].second, data, o.refit).model;
   out.model.nominal.name = spec.Text();

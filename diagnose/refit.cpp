@@ -78,21 +78,45 @@ void Residual(const AugmentedModel& m, const Segment& s, Vec* r) {
   for (std::size_t t = s.skip; t < end; ++t) (*r)[t - s.skip] = y[t] - yhat[t];
 }
 
+// Whether a polynomial map is monotone on [lo, hi] (its derivative keeps one sign on a fine grid).
+bool MonotoneOn(const StaticMap& map, double lo, double hi) {
+  if (map.kind != StaticMap::Kind::kPolynomial || !(hi > lo)) return true;
+  int sign = 0;
+  for (int i = 0; i <= 64; ++i) {
+    const double v = lo + (hi - lo) * i / 64.0;
+    double d = 0.0;
+    for (std::size_t k = 0; k < map.coefficients.size(); ++k) d += (k + 1) * map.coefficients[k] * std::pow(v, k);
+    const int sd = d > 0 ? 1 : (d < 0 ? -1 : 0);
+    if (sd != 0 && sign != 0 && sd != sign) return false;
+    if (sd != 0) sign = sd;
+  }
+  return true;
+}
+
 Vec LmScale(const Vec& p0) {
   Vec scale(p0.size());
   for (std::size_t i = 0; i < p0.size(); ++i) scale[i] = std::max(std::abs(p0[i]), 1e-3);
   return scale;
 }
 
-// LM over the numbers chosen by `pk`.
+// LM over the numbers chosen by `pk`. A step that would make a monotone static map non-monotone over
+// the data is refused (a bad but finite cost): actuator and sensor characteristics are monotone, and a
+// map that folds back could mimic a missing effect instead of letting the diagnosis name it.
 void Lm(AugmentedModel* m, const Packing& pk, const Segment& s, const LmOptions& lo) {
   Vec p0 = pk.Pack(*m);
   if (p0.empty()) return;
   AugmentedModel work = *m;
+  const bool guard = (pk.nin > 0 || pk.nout > 0) && MapsMonotone(*m, *s.u);
+  double refused = 1.0;
+  for (std::size_t t = s.skip; t < s.End(); ++t) refused = std::max(refused, 1e3 * std::abs((*s.y)[t]));
   LmSummary sum;
   const Vec p = LevenbergMarquardt(
       [&](const Vec& q, Vec* r) {
         pk.Unpack(q, &work);
+        if (guard && !MapsMonotone(work, *s.u)) {
+          r->assign(s.Count(), refused);
+          return;
+        }
         Residual(work, s, r);
       },
       p0, LmScale(p0), lo, &sum);
@@ -313,6 +337,22 @@ bool RefitOptions::IsValid(std::string* error) const {
     return false;
   }
   return lm.IsValid(error);
+}
+
+bool MapsMonotone(const AugmentedModel& m, const Vec& u) {
+  if (u.empty()) return true;
+  const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
+  if (!MonotoneOn(m.nominal.input, *ulo, *uhi)) return false;
+  if (m.nominal.output.kind != StaticMap::Kind::kPolynomial) return true;
+  AugmentedModel inner = m;  // the output map sees z: simulate up to it
+  inner.nominal.output = StaticMap{};
+  inner.output_offset = 0.0;
+  inner.blocks.erase(std::remove_if(inner.blocks.begin(), inner.blocks.end(),
+                                    [](const EffectBlock& b) { return b.location == Location::kOutput; }),
+                     inner.blocks.end());
+  const Vec z = inner.simulate(u);
+  const auto [zlo, zhi] = std::minmax_element(z.begin(), z.end());
+  return MonotoneOn(m.nominal.output, *zlo, *zhi);
 }
 
 int EffectParameterCount(const AugmentedModel& m) {

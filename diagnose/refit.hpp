@@ -86,6 +86,10 @@ std::vector<double> StabilisedDenominator(const std::vector<double>& a);
 bool FitArx(const std::vector<double>& x, const std::vector<double>& y, int na, int nb, int d, std::size_t skip,
             std::size_t end, bool with_constant, std::vector<double>* a, std::vector<double>* b, double* constant);
 
+// Whether the polynomial static maps are monotone over the signals they see for input u (the input map
+// over u's range, the output map over the simulated z's range). Identity maps are monotone.
+bool MapsMonotone(const AugmentedModel& m, const std::vector<double>& u);
+
 // Number of effect parameters of the blocks that are estimated (finite).
 int EffectParameterCount(const AugmentedModel& m);
 

@@ -7,7 +7,9 @@
 // For each: the nominal is fitted by the tool (--fit), the diagnosis runs with default options, and the
 // table row says whether the documented physics is named, how many of the samples where it acts lie in
 // the windows, and the validation RMSE before and after.
-// Usage: diagnose_real [OUT_DIR] [NAME]   (defaults: diagnose_real_out, all; NAME = silverbox, tanks, emps)
+// Usage: diagnose_real [OUT_DIR] [NAME] [--settings]   (defaults: diagnose_real_out, all; NAME = silverbox,
+// tanks, emps or all). With --settings, each recording is also diagnosed under a grid of reasonable
+// settings (nominal structures x held-out fractions x warm-up samples) and the verdicts are counted.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -26,6 +28,7 @@ struct RealCase {
   std::string name, title, physics, expected;  // expected verdict label, e.g. "cubic_stiffness@state"
   std::string acts_in;                         // per-block windows compared with `acts` (e.g. "... upper limit")
   std::string nominal;                         // --fit structure
+  std::vector<std::string> other_nominals;     // further reasonable structures for the settings grid
   StateVariable state = StateVariable::kPosition;
   std::size_t init_samples = 0;
   std::function<void(Recording*, Recording*)> load;
@@ -52,6 +55,7 @@ std::vector<RealCase> Cases() {
     c.expected = "cubic_stiffness@state";
     c.acts_in = "cubic_stiffness@state";
     c.nominal = "linear:2,3";
+    c.other_nominals = {"linear:2,2", "linear:3,3", "hw:2,3,1,3"};
     c.init_samples = 50;
     c.load = [](Recording* id, Recording* va) {
       ColumnNames cols;
@@ -79,6 +83,7 @@ std::vector<RealCase> Cases() {
     c.expected = "state_saturation@state";
     c.acts_in = "state_saturation@state upper limit";
     c.nominal = "linear:2,2";
+    c.other_nominals = {"linear:2,3", "linear:3,3", "hw:2,2,2,1", "hw:2,2,1,2", "hw:2,2,3,1"};
     c.load = [](Recording* id, Recording* va) {
       const std::string f = SourceDir() + "/paper_examples/data/cascaded_tanks/dataBenchmark.csv";
       ColumnNames e, v;
@@ -100,6 +105,7 @@ std::vector<RealCase> Cases() {
     c.expected = "coulomb_friction@state";
     c.acts_in = "coulomb_friction@state";
     c.nominal = "linear:1,1,1";
+    c.other_nominals = {"linear:1,1,0", "linear:1,2,1", "linear:2,2,1"};
     c.state = StateVariable::kVelocity;
     c.load = [](Recording* id, Recording* va) {
       ColumnNames cols;
@@ -136,11 +142,49 @@ Overlap Compare(const std::vector<bool>& windows, const std::vector<bool>& acts,
   return {na ? double(both) / na : 0.0, nw ? double(both) / nw : 0.0};
 }
 
+bool Named(const std::string& label, const std::string& expected) {
+  return label.rfind(expected, 0) == 0 || label.find("+" + expected) != std::string::npos;
+}
+
+// The recording under every combination of structure, held-out fraction and warm-up length.
+std::string SettingsGrid(const RealCase& c, const Recording& ident, const Recording& valid) {
+  std::vector<std::string> structures = {c.nominal};
+  structures.insert(structures.end(), c.other_nominals.begin(), c.other_nominals.end());
+  int named = 0, total = 0;
+  std::string rows;
+  for (const auto& structure : structures)
+    for (double holdout : {1.0 / 3, 0.25})
+      for (std::size_t warm : {c.init_samples, c.init_samples + 50}) {
+        DiagnoseOptions o;
+        o.init_samples = warm;
+        o.holdout_fraction = holdout;
+        o.state_variable = c.state;
+        const NominalSpec spec = NominalSpec::Parse(structure);
+        DiagnoseReport r;
+        try {
+          const NominalFit fit = FitNominal(spec, {&ident.u, &ident.y, warm, 0}, o.nominal_fit);
+          Diagnose(o, fit.model, &spec, ident, valid, &r);
+        } catch (const std::exception& e) {
+          r.message = e.what();
+        }
+        const std::string label = !r.ok ? "error" : (r.verdict == Effect::kNone ? "none" : r.augmented_model.Label());
+        ++total;
+        named += Named(label, c.expected);
+        rows += fmt::format("| `{}` | {:.2f} | {} | `{}` | {:.4g} -> {:.4g} |\n", structure, holdout, warm, label,
+                            r.nominal_refit.rmse, r.augmented.rmse);
+      }
+  return fmt::format("#### {}: documented physics named in {} of {} settings\n\n| nominal | held-out | warm-up | "
+                     "verdict | validation RMSE |\n|---|---|---|---|---|\n{}\n",
+                     c.title, named, total, rows);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string out = argc > 1 ? argv[1] : "diagnose_real_out";
-  const std::string only = argc > 2 ? argv[2] : "";
+  const std::string only = argc > 2 && std::string(argv[2]) != "all" ? argv[2] : "";
+  const bool grid = argc > 3 && std::string(argv[3]) == "--settings";
+  std::string settings;
   std::string md =
       "| recording | documented physics | nominal | verdict | physics named | samples where it acts inside the "
       "windows | windows hold (precision) | flagged | validation RMSE nominal refit -> augmented | fit % |\n"
@@ -172,7 +216,7 @@ int main(int argc, char** argv) {
     }
     WriteReport(r, ident, valid, out + "/" + c.name);
     const std::string label = r.verdict == Effect::kNone ? "none" : r.augmented_model.Label();
-    const bool named = label.rfind(c.expected, 0) == 0 || label.find("+" + c.expected) != std::string::npos;
+    const bool named = Named(label, c.expected);
     // The windows of the block (or limit) that carries the documented physics; all windows otherwise.
     std::vector<bool> windows = r.mask;
     for (const auto& w : r.block_windows)
@@ -190,9 +234,10 @@ int main(int argc, char** argv) {
     details += fmt::format("### {}\n\n{}\n\nWhere the physics acts: {}. {}. Report: `{}/{}/report.md`.\n\n", c.title,
                            r.message, c.acts_text, r.initial_state_note, out, c.name);
     fmt::print("{}: {} (expected {}), {:.1f} s\n", c.name, label, c.expected, r.seconds);
+    if (grid) settings += SettingsGrid(c, ident, valid);
   }
   std::filesystem::create_directories(out);
-  hw::write_text_atomic(out + "/real_recordings.md", md + "\n" + details);
-  fmt::print("{}\n{}", md, details);
+  hw::write_text_atomic(out + "/real_recordings.md", md + "\n" + details + settings);
+  fmt::print("{}\n{}{}", md, details, settings);
   return failures ? 1 : 0;
 }
