@@ -174,7 +174,7 @@ void FindBias(const std::vector<Condition>& conditions, const std::vector<double
   b.condition == "dir_u" || b.condition == "dir_y"
       ? r->bias.description = fmt::format("the {0}'s sign follows the direction of {1}: mean {2:+.4g} after {1} rose, {3:+.4g} after it fell "
                                           "({4:.2f} {0} standard deviations apart)", subject, sig, b.mean_above, b.mean_below, b.effect_size)
-      : r->bias.description = fmt::format("the mean {} changes across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} {} "
+      : r->bias.description = fmt::format("the mean {} differs across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} {} "
                                           "standard deviations apart)", subject, b.condition, b.threshold, b.mean_above, b.mean_below, b.effect_size, subject);
   (void)dir;
 }

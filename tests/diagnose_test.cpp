@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 
@@ -348,6 +349,41 @@ TEST(Report, WritesJsonMarkdownAndSchemaKeys) {
   EXPECT_NO_THROW(AugmentedModel::Load(dir + "/augmented_model.json"));
   std::filesystem::remove_all(dir);
 }
+
+#ifdef HW_CLI_PATH
+// The command line: different column names per recording, and a model file in another layout is an
+// error (exit code 2) naming the unknown key, with nothing written.
+TEST(Cli, ColumnNamesPerFileAndStrictModelFiles) {
+  const auto dir = std::filesystem::temp_directory_path() / "hw_diagnose_cli";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  ScenarioOptions so;
+  so.seed = 3;
+  so.samples = 600;
+  const Scenario sc = MakeScenario(so);
+  {
+    std::ofstream f(dir / "bench.csv");
+    f << "\"uEst\",\"yEst\",\"uVal\",\"yVal\",\n";
+    for (std::size_t t = 0; t < sc.ident.u.size(); ++t)
+      f << sc.ident.u[t] << "," << sc.ident.y[t] << "," << sc.valid.u[t] << "," << sc.valid.y[t] << ",\n";
+  }
+  std::ofstream(dir / "bad.json") << R"({"linear": {"a": [-1.2, 0.5], "b": [0.2, 0.1]}, "output_poly": [1, 0.5]})";
+  const std::string bench = (dir / "bench.csv").string();
+  const std::string base = std::string(HW_CLI_PATH) + " diagnose --data " + bench + ":u=uEst,y=yEst --validate " +
+                           bench + ":u=uVal,y=yVal --threads 1 ";
+  const std::string log = (dir / "log.txt").string();
+  EXPECT_EQ(std::system((base + "--fit linear:2,2 --out " + (dir / "ok").string() + " > " + log + " 2>&1").c_str()), 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "ok" / "report.json"));
+  const int rc = std::system((base + "--model " + (dir / "bad.json").string() + " --out " + (dir / "bad").string() +
+                              " > " + log + " 2>&1").c_str());
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("output_poly"), std::string::npos) << text;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  std::filesystem::remove_all(dir);
+}
+#endif
 
 }  // namespace
 }  // namespace hw::diagnose
