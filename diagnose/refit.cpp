@@ -99,6 +99,42 @@ Vec LmScale(const Vec& p0) {
   return scale;
 }
 
+// The linear block's output z of m for input u (no output map, offset or output blocks).
+Vec InnerState(const AugmentedModel& m, const Vec& u) {
+  AugmentedModel inner = m;
+  inner.nominal.output = StaticMap{};
+  inner.output_offset = 0.0;
+  inner.blocks.erase(std::remove_if(inner.blocks.begin(), inner.blocks.end(),
+                                    [](const EffectBlock& b) { return b.location == Location::kOutput; }),
+                     inner.blocks.end());
+  return inner.simulate(u);
+}
+
+// A weak prior on the initial state: an initial z a hundred ranges of z away from z's mean costs as much
+// as one typical sample error. Legitimate initial states (within a few ranges) cost next to nothing; it
+// only stops ill-conditioned estimates (slow, nearly equal poles, warm-up samples excluded) from
+// running off to values no recording could produce.
+struct InitialStatePrior {
+  double centre = 0.0, weight = 0.0;
+  InitialStatePrior(const AugmentedModel& m, const Segment& s, int ninit) {
+    if (ninit == 0 || s.Count() == 0) return;
+    const Vec zall = InnerState(m, *s.u);
+    const Vec z(zall.begin() + s.skip, zall.begin() + s.End());  // where the data constrain it
+    const auto [lo, hi] = std::minmax_element(z.begin(), z.end());
+    Vec r;
+    Residual(m, s, &r);
+    double e2 = 0.0;
+    for (double v : r) e2 += v * v;
+    const double rms = std::sqrt(e2 / r.size());
+    centre = 0.5 * (*lo + *hi);
+    weight = std::isfinite(rms) ? std::max(rms, 1e-12) / (100.0 * std::max(*hi - *lo, 1e-12)) : 0.0;
+  }
+  void Append(const AugmentedModel& m, int ninit, Vec* r) const {
+    for (int i = 0; i < ninit; ++i)
+      r->push_back(weight * ((i < static_cast<int>(m.initial_state.size()) ? m.initial_state[i] : 0.0) - centre));
+  }
+};
+
 // LM over the numbers chosen by `pk`. A step that would make a monotone static map non-monotone over
 // the data is refused (a bad but finite cost): actuator and sensor characteristics are monotone, and a
 // map that folds back could mimic a missing effect instead of letting the diagnosis name it.
@@ -107,6 +143,7 @@ void Lm(AugmentedModel* m, const Packing& pk, const Segment& s, const LmOptions&
   if (p0.empty()) return;
   AugmentedModel work = *m;
   const bool guard = (pk.nin > 0 || pk.nout > 0) && MapsMonotone(*m, *s.u);
+  const InitialStatePrior prior(*m, s, pk.ninit);
   double refused = 1.0;
   for (std::size_t t = s.skip; t < s.End(); ++t) refused = std::max(refused, 1e3 * std::abs((*s.y)[t]));
   LmSummary sum;
@@ -114,10 +151,11 @@ void Lm(AugmentedModel* m, const Packing& pk, const Segment& s, const LmOptions&
       [&](const Vec& q, Vec* r) {
         pk.Unpack(q, &work);
         if (guard && !MapsMonotone(work, *s.u)) {
-          r->assign(s.Count(), refused);
+          r->assign(s.Count() + pk.ninit, refused);
           return;
         }
         Residual(work, s, r);
+        prior.Append(work, pk.ninit, r);
       },
       p0, LmScale(p0), lo, &sum);
   pk.Unpack(p, m);
@@ -344,13 +382,7 @@ bool MapsMonotone(const AugmentedModel& m, const Vec& u) {
   const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
   if (!MonotoneOn(m.nominal.input, *ulo, *uhi)) return false;
   if (m.nominal.output.kind != StaticMap::Kind::kPolynomial) return true;
-  AugmentedModel inner = m;  // the output map sees z: simulate up to it
-  inner.nominal.output = StaticMap{};
-  inner.output_offset = 0.0;
-  inner.blocks.erase(std::remove_if(inner.blocks.begin(), inner.blocks.end(),
-                                    [](const EffectBlock& b) { return b.location == Location::kOutput; }),
-                     inner.blocks.end());
-  const Vec z = inner.simulate(u);
+  const Vec z = InnerState(m, u);  // what the output map sees
   const auto [zlo, zhi] = std::minmax_element(z.begin(), z.end());
   return MonotoneOn(m.nominal.output, *zlo, *zhi);
 }
@@ -496,16 +528,7 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   if (effect == Effect::kNone || base.blocks.size() >= 2) return RefitModel(base, s, o);
   const Vec& u = *s.u;
   // The signal the block acts on, from the current model: the state for state blocks.
-  Vec zhat;
-  {
-    AugmentedModel lin = base;
-    lin.nominal.output = StaticMap{};
-    lin.output_offset = 0.0;
-    lin.blocks.erase(std::remove_if(lin.blocks.begin(), lin.blocks.end(),
-                                    [](const EffectBlock& b) { return b.location == Location::kOutput; }),
-                     lin.blocks.end());
-    lin.simulate(u, &zhat);
-  }
+  const Vec zhat = InnerState(base, u);
   Vec input = u;  // a second input block acts after the first one
   for (const auto& b : base.blocks)
     if (b.location == Location::kInput) input = ApplyInputBlock(b, input);
