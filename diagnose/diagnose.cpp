@@ -315,30 +315,105 @@ std::string Finding::Label() const {
   return s.empty() ? "none" : s;
 }
 
+namespace {
+
+// Why the inputs cannot be diagnosed, or "" when they can.
+std::string InputProblem(const DiagnoseOptions& o, const AugmentedModel& nominal, const Recording& ident,
+                         const Recording& valid) {
+  std::string err;
+  if (!o.IsValid(&err)) return "invalid options: " + err;
+  if (nominal.has_block()) return "the nominal model already holds effect blocks; diagnose the model without them";
+  if (ident.u.size() != ident.y.size() || valid.u.size() != valid.y.size()) return "u and y must have equal lengths";
+  if (ident.y.size() < o.init_samples + 60 || valid.y.size() < o.init_samples + 30)
+    return fmt::format("recordings too short: need at least {} identification and {} validation samples after the {} "
+                       "initial samples", 60, 30, o.init_samples);
+  return "";
+}
+
+// Noise level: given, or a robust estimate from the residual's differences capped by what the baseline
+// and the eligible candidates reach.
+double NoiseLevel(const Context& c, const Vec& e_nom, const Reference& base, const std::vector<Finding>& findings) {
+  if (c.o.noise_std > 0) return c.o.noise_std;
+  double sigma = std::min(EstimateNoiseStd(e_nom, c.skip), std::sqrt(Mse(base.ident_residual, c.skip, c.nfit)));
+  for (const auto& f : findings)
+    if (f.eligible) sigma = std::min(sigma, std::sqrt(Mse(c.IdentResidual(f.model), c.skip, c.n)));
+  return sigma;
+}
+
+// Figures on both recordings for the given nominal, the nominal refit and the augmented model; returns
+// the validation residuals of the refit and of the augmented model.
+std::pair<Vec, Vec> Figure(const Context& c, const AugmentedModel& nominal, const Finding* verdict, DiagnoseReport* r) {
+  const Vec v_given = c.ValidationResidual(nominal), v_refit = c.ValidationResidual(r->nominal_refit_model);
+  auto sim_of = [&](const Vec& e) {
+    Vec s(c.valid.y.size());
+    for (std::size_t t = 0; t < s.size(); ++t) s[t] = c.valid.y[t] - e[t];
+    return s;
+  };
+  r->valid_nominal_sim = sim_of(v_given);
+  r->nominal = Figures(c.valid.y, r->valid_nominal_sim, c.skip);
+  r->nominal_refit = Figures(c.valid.y, sim_of(v_refit), c.skip);
+  r->refit_z = PairedZ(v_given, v_refit, c.skip, c.nv, c.batch);
+  r->parameters_off = r->refit_z >= c.o.validation_z && r->nominal_refit.rmse * r->nominal_refit.rmse <=
+                                                            (1.0 - c.o.min_improvement) * r->nominal.rmse * r->nominal.rmse;
+  r->augmented_model = verdict ? verdict->model : r->nominal_refit_model;
+  const Vec v_aug = c.ValidationResidual(r->augmented_model);
+  r->valid_augmented_sim = sim_of(v_aug);
+  r->augmented = Figures(c.valid.y, r->valid_augmented_sim, c.skip);
+  r->ident_augmented_sim = r->augmented_model.simulate(c.ident.u);
+  r->ident_nominal = Figures(c.ident.y, r->ident_nominal_sim, c.skip);
+  r->ident_augmented = Figures(c.ident.y, r->ident_augmented_sim, c.skip);
+  return {v_refit, v_aug};
+}
+
+void Conclude(const Context& c, const Finding* verdict, DiagnoseReport* r) {
+  if (verdict) {
+    r->verdict_blocks = verdict->model.blocks;
+    r->verdict = r->verdict_blocks.front().effect;
+    r->verdict_location = r->verdict_blocks.front().location;
+    r->validation_z = verdict->validation.z;
+    r->validation_note = fmt::format("validation confirms {}: paired z = {:.1f} >= {:.1f}, MSE {:.3g}x the baseline's",
+                                     verdict->Label(), verdict->validation.z, c.o.validation_z, verdict->validation.ratio);
+    return;
+  }
+  int held = 0;
+  for (const auto& f : r->findings) held += f.holdout.significant;
+  r->validation_note = held == 0 ? "no candidate improved the held-out identification tail significantly"
+                                 : fmt::format("{} candidate(s) improved the held-out tail but none the validation "
+                                               "recording as well (paired z >= {:.1f} and >= {:.0f} % MSE reduction)",
+                                               held, c.o.validation_z, 100 * c.o.min_improvement);
+}
+
+// Windows: where the verdict's blocks change the prediction, or (no verdict) where the refitted
+// nominal's residual exceeds the noise; their operating region.
+void Locate(const Context& c, bool verdict, const Vec& e_nom, const Vec& v_refit, DiagnoseReport* r) {
+  const double sigma = r->noise_std;
+  r->conditions = OperatingConditions(c.ident.u, r->nominal_refit_model.simulate(c.ident.u));
+  r->residual_mask = MismatchMask(e_nom, sigma, c.skip, c.o.windows);
+  Vec weight;
+  if (verdict) {
+    r->mask = BlockEffectMask(r->augmented_model, c.ident.u, sigma, c.skip, &weight);
+    r->block_windows = PerBlockMasks(r->augmented_model, c.ident.u, sigma, c.skip);
+    r->mask_source = "samples where the verdict's blocks change the prediction by more than the noise";
+    r->validation_windows = MaskToWindows(BlockEffectMask(r->augmented_model, c.valid.u, sigma, c.skip, nullptr));
+  } else {
+    weight = c.IdentResidual(r->nominal_refit_model);
+    r->mask = MismatchMask(weight, sigma, c.skip, c.o.windows);
+    r->mask_source = "samples where the refitted nominal's local mean-square error exceeds the noise";
+    r->validation_windows = MaskToWindows(MismatchMask(v_refit, sigma, c.skip, c.o.windows));
+  }
+  r->windows = MaskToWindows(r->mask);
+  r->region = CharacteriseRegion(r->conditions, r->mask, weight, c.skip, verdict ? "change" : "error");
+}
+
+}  // namespace
+
 void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const NominalSpec* structure,
               const Recording& ident, const Recording& valid, DiagnoseReport* rep) {
   const auto start = std::chrono::steady_clock::now();
   DiagnoseReport& r = *rep;
   r = DiagnoseReport{};
-  std::string err;
-  if (!o.IsValid(&err)) {
-    r.message = "invalid options: " + err;
-    return;
-  }
-  if (nominal.has_block()) {
-    r.message = "the nominal model already holds effect blocks; diagnose the model without them";
-    return;
-  }
-  const std::size_t n = ident.y.size(), skip = o.init_samples;
-  if (ident.u.size() != n || valid.u.size() != valid.y.size()) {
-    r.message = "u and y must have equal lengths";
-    return;
-  }
-  if (n < skip + 60 || valid.y.size() < skip + 30) {
-    r.message = fmt::format("recordings too short: need at least {} identification and {} validation samples after "
-                            "the {} initial samples", 60, 30, skip);
-    return;
-  }
+  r.message = InputProblem(o, nominal, ident, valid);
+  if (!r.message.empty()) return;
   const Context c(o, ident, valid);
   r.nominal_model = nominal;
 
@@ -347,95 +422,33 @@ void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const Nom
   EstimateInitialState(&given, c.full, o.refit);
   r.ident_nominal_sim = given.simulate(ident.u);
   const Vec e_nom = Residual(ident.y, r.ident_nominal_sim);
-  for (double v : e_nom)
-    if (!std::isfinite(v)) {
-      r.message = "the nominal model's simulation is not finite on the identification recording (unstable model?)";
-      return;
-    }
-  r.whiteness_nominal = WhitenessTest(e_nom, skip, o.max_lag);
-  r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, skip, o.max_lag);
+  if (!std::all_of(e_nom.begin(), e_nom.end(), [](double v) { return std::isfinite(v); })) {
+    r.message = "the nominal model's simulation is not finite on the identification recording (unstable model?)";
+    return;
+  }
+  r.whiteness_nominal = WhitenessTest(e_nom, c.skip, o.max_lag);
+  r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, c.skip, o.max_lag);
 
-  // 1-2. Baseline and every single block.
+  // Baseline, every single block, and a combination of two when it beats the best single one.
   const Reference base = Baseline(c, nominal, structure, &r);
   r.findings = SearchSingles(c, base);
   r.nominal_refit_model = RefitModel(base.fitted, c.full, o.refit).model;
-
-  // Noise level: robust estimate from the residual's differences, capped by what the best model reaches.
   r.noise_estimated = !(o.noise_std > 0);
-  double sigma = o.noise_std;
-  if (r.noise_estimated) {
-    sigma = std::min(EstimateNoiseStd(e_nom, skip), std::sqrt(Mse(base.ident_residual, skip, c.nfit)));
-    for (const auto& f : r.findings)
-      if (f.eligible) sigma = std::min(sigma, std::sqrt(Mse(c.IdentResidual(f.model), skip, n)));
-  }
-  r.noise_std = sigma;
-
-  // 3. Verdict (and a combination of two blocks when it beats the single one).
+  r.noise_std = NoiseLevel(c, e_nom, base, r.findings);
   const Finding* verdict = !r.findings.empty() && r.findings.front().eligible ? &r.findings.front() : nullptr;
   if (verdict && o.try_pairs && o.pair_partners > 0) {
     r.pairs = SearchPairs(c, *verdict, r.findings);
     if (!r.pairs.empty() && r.pairs.front().eligible) verdict = &r.pairs.front();
   }
 
-  // Validation figures.
-  const Vec v_given = c.ValidationResidual(nominal), v_refit = c.ValidationResidual(r.nominal_refit_model);
-  auto sim_of = [&](const Vec& e) {
-    Vec s(valid.y.size());
-    for (std::size_t t = 0; t < s.size(); ++t) s[t] = valid.y[t] - e[t];
-    return s;
-  };
-  r.valid_nominal_sim = sim_of(v_given);
-  r.nominal = Figures(valid.y, r.valid_nominal_sim, skip);
-  r.nominal_refit = Figures(valid.y, sim_of(v_refit), skip);
-  r.refit_z = PairedZ(v_given, v_refit, skip, valid.y.size(), c.batch);
-  r.parameters_off = r.refit_z >= o.validation_z &&
-                     r.nominal_refit.rmse * r.nominal_refit.rmse <= (1.0 - o.min_improvement) * r.nominal.rmse * r.nominal.rmse;
-  r.augmented_model = verdict ? verdict->model : r.nominal_refit_model;
-  const Vec v_aug = c.ValidationResidual(r.augmented_model);
-  r.valid_augmented_sim = sim_of(v_aug);
-  r.augmented = Figures(valid.y, r.valid_augmented_sim, skip);
-  r.ident_augmented_sim = r.augmented_model.simulate(ident.u);
-  r.ident_nominal = Figures(ident.y, r.ident_nominal_sim, skip);
-  r.ident_augmented = Figures(ident.y, r.ident_augmented_sim, skip);
-  if (verdict) {
-    r.verdict_blocks = verdict->model.blocks;
-    r.verdict = r.verdict_blocks.front().effect;
-    r.verdict_location = r.verdict_blocks.front().location;
-    r.validation_z = verdict->validation.z;
-    r.validation_note = fmt::format("validation confirms {}: paired z = {:.1f} >= {:.1f}, MSE {:.3g}x the baseline's",
-                                    verdict->Label(), verdict->validation.z, o.validation_z, verdict->validation.ratio);
-  } else {
-    int held = 0;
-    for (const auto& f : r.findings) held += f.holdout.significant;
-    r.validation_note = held == 0 ? "no candidate improved the held-out identification tail significantly"
-                                  : fmt::format("{} candidate(s) improved the held-out tail but none the validation "
-                                                "recording as well (paired z >= {:.1f} and >= {:.0f} % MSE reduction)",
-                                                held, o.validation_z, 100 * o.min_improvement);
-  }
-
-  // 4. Locate.
-  r.conditions = OperatingConditions(ident.u, r.nominal_refit_model.simulate(ident.u));
-  r.residual_mask = MismatchMask(e_nom, sigma, skip, o.windows);
-  const Vec e_base_full = c.IdentResidual(r.nominal_refit_model);
-  Vec weight;
-  if (verdict) {
-    r.mask = BlockEffectMask(r.augmented_model, ident.u, sigma, skip, &weight);
-    r.block_windows = PerBlockMasks(r.augmented_model, ident.u, sigma, skip);
-    r.mask_source = "samples where the verdict's blocks change the prediction by more than the noise";
-    r.validation_windows = MaskToWindows(BlockEffectMask(r.augmented_model, valid.u, sigma, skip, nullptr));
-  } else {
-    r.mask = MismatchMask(e_base_full, sigma, skip, o.windows);
-    weight = e_base_full;
-    r.mask_source = "samples where the refitted nominal's local mean-square error exceeds the noise";
-    r.validation_windows = MaskToWindows(MismatchMask(v_refit, sigma, skip, o.windows));
-  }
-  r.windows = MaskToWindows(r.mask);
-  r.region = CharacteriseRegion(r.conditions, r.mask, weight, skip, verdict ? "change" : "error");
-  for (auto& f : r.findings) f.in_window_share = ImprovementShareIn(r.residual_mask, base.ident_residual,
-                                                                      c.IdentResidual(f.fitted), c.nfit, n);
-  r.initial_state_note = InitialStateNote(r.nominal_refit_model, ident.u, sigma);
-  r.whiteness_augmented = WhitenessTest(v_aug, skip, o.max_lag);
-  r.input_corr_augmented = InputCorrelationTest(v_aug, valid.u, skip, o.max_lag);
+  const auto [v_refit, v_aug] = Figure(c, nominal, verdict, &r);
+  Conclude(c, verdict, &r);
+  Locate(c, verdict != nullptr, e_nom, v_refit, &r);
+  for (auto& f : r.findings)
+    f.in_window_share = ImprovementShareIn(r.residual_mask, base.ident_residual, c.IdentResidual(f.fitted), c.nfit, c.n);
+  r.initial_state_note = InitialStateNote(r.nominal_refit_model, ident.u, r.noise_std);
+  r.whiteness_augmented = WhitenessTest(v_aug, c.skip, o.max_lag);
+  r.input_corr_augmented = InputCorrelationTest(v_aug, valid.u, c.skip, o.max_lag);
   r.ok = true;
   Summarise(&r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
