@@ -263,13 +263,14 @@ std::vector<std::string> WriteReport(const DiagnoseReport& r, const Recording& i
     written.push_back(p);
   }
   const std::string verdict = Verdict(r);
+  const std::string shade = r.verdict == Effect::kNone ? "residual beyond the noise" : "where the verdict acts";
   std::string gp = "set terminal pngcairo size 1200,500 noenhanced\nset grid\nset key outside top center horizontal\n";
   gp += ShadeWindows(r.windows, ident.t);
   gp += fmt::format(
-      "set output 'identification.png'\nset title 'Identification: y, nominal and augmented ({}) simulations; shaded = nominal error beyond the noise'\nset xlabel 't'\nset ylabel 'y'\n"
+      "set output 'identification.png'\nset title 'Identification: y and simulations, augmented = {}; shaded = {}'\nset xlabel 't'\nset ylabel 'y'\n"
       "plot 'identification.dat' u 1:2 w l lc rgb '#999999' t 'y measured', '' u 1:3 w l lw 1.5 lc rgb '#d62728' t "
       "'nominal', '' u 1:4 w l lw 1.5 lc rgb '#1f77b4' t 'augmented'\n",
-      verdict);
+      verdict, shade);
   gp += fmt::format(
       "set output 'residual_time.png'\nset title 'Simulation error on the identification recording (±3 sigma "
       "noise band)'\nset ylabel 'y - yhat'\nplot 'identification.dat' u 1:5 w l lc rgb '#d62728' t 'nominal', '' u "
@@ -277,7 +278,7 @@ std::vector<std::string> WriteReport(const DiagnoseReport& r, const Recording& i
       "rgb 'black' t '-3 sigma'\n",
       3 * r.noise_std);
   gp += ShadeWindows(r.validation_windows, valid.t);
-  gp += "set output 'validation.png'\nset title 'Validation: y, nominal and augmented simulations; shaded = nominal error beyond the noise'\nset ylabel 'y'\n"
+  gp += "set output 'validation.png'\nset title 'Validation: y and simulations; shaded = " + shade + "'\nset ylabel 'y'\n"
         "plot 'validation.dat' u 1:2 w l lc rgb '#999999' t 'y measured', '' u 1:3 w l lw 1.5 lc rgb '#d62728' t "
         "'nominal', '' u 1:4 w l lw 1.5 lc rgb '#1f77b4' t 'augmented'\n";
   if (cond) {
