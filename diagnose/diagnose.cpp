@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "core/csv_table.hpp"
 #include "diagnose/locate.hpp"
 
 namespace hw::diagnose {
@@ -187,13 +188,17 @@ Reference Baseline(const Context& c, const AugmentedModel& nominal, const Nomina
   if (structure || NominalSpec::Of(nominal.nominal, &spec)) {
     NominalFitOptions no = c.o.nominal_fit;
     no.refit = c.o.refit;
-    const NominalFit fresh = FitNominal(structure ? *structure : spec, c.fit, no);  // chooses inside the fitting part
-    const double h = holdout_rmse(fresh.model);
-    r->baseline_starts.push_back({"fresh starts: " + fresh.Summary(),
-                                  std::sqrt(SumSquaredError(fresh.model, c.fit) / c.fit.Count()), h});
-    if (h < r->baseline_starts.front().holdout_rmse) {
-      best = fresh.model;
-      r->baseline_source = "fresh starts of the nominal structure (" + fresh.starts[fresh.chosen].name + ")";
+    try {
+      const NominalFit fresh = FitNominal(structure ? *structure : spec, c.fit, no);  // chooses inside the fitting part
+      const double h = holdout_rmse(fresh.model);
+      r->baseline_starts.push_back({"fresh starts: " + fresh.Summary(),
+                                    std::sqrt(SumSquaredError(fresh.model, c.fit) / c.fit.Count()), h});
+      if (h < r->baseline_starts.front().holdout_rmse) {
+        best = fresh.model;
+        r->baseline_source = "fresh starts of the nominal structure (" + fresh.starts[fresh.chosen].name + ")";
+      }
+    } catch (const InputError& e) {  // e.g. too short a fitting part for the structure: keep the refit
+      r->baseline_starts.push_back({std::string("fresh starts not possible: ") + e.what(), HUGE_VAL, HUGE_VAL});
     }
   }
   Reference ref;
