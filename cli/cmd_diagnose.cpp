@@ -6,67 +6,106 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
-#include "core/hw_model.hpp"
 #include "diagnose/diagnose.hpp"
 
 namespace hw::cli {
+namespace {
+
+struct Opts {
+  std::string data, validate, model, fit, out, effects, state_variable = "position";
+  diagnose::ColumnNames ident_cols, valid_cols;
+  bool no_pairs = false, no_initial_state = false;
+  diagnose::DiagnoseOptions o;
+};
+
+void Run(const Opts& p, bool t_named, bool valid_t_named) {
+  CheckOutputDirectory(p.out, "--out");
+  diagnose::DiagnoseOptions o = p.o;
+  if (p.model.empty() == p.fit.empty()) throw InputError("diagnose needs exactly one of --model FILE or --fit SPEC");
+  if (!p.effects.empty()) o.candidates = diagnose::ParseCandidates(p.effects);
+  o.state_variable = diagnose::ParseStateVariable(p.state_variable);
+  o.try_pairs = !p.no_pairs;
+  o.refit.estimate_initial_state = !p.no_initial_state;
+  o.nominal_fit.refit.estimate_initial_state = !p.no_initial_state;
+  std::string err;
+  if (!o.IsValid(&err)) throw InputError("diagnose: " + err);
+  diagnose::ColumnNames ic = p.ident_cols, vc = p.valid_cols;
+  ic.t_required = t_named;
+  vc.t_required = valid_t_named;
+  const auto ident = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.data, ic));
+  const auto valid = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.validate, vc));
+  diagnose::AugmentedModel nominal;
+  std::unique_ptr<diagnose::NominalSpec> spec;
+  if (!p.model.empty()) {
+    nominal = diagnose::AugmentedModel::Load(p.model);
+    if (nominal.has_block())
+      throw InputError(fmt::format("{}: the model holds effect blocks ({}); give the nominal model without them",
+                                   p.model, nominal.Label()));
+  } else {
+    spec = std::make_unique<diagnose::NominalSpec>(diagnose::NominalSpec::Parse(p.fit));
+    const diagnose::NominalFit fit =
+        diagnose::FitNominal(*spec, {&ident.u, &ident.y, o.init_samples, 0}, o.nominal_fit);
+    fmt::print("{}\n", fit.Summary());
+    nominal = fit.model;
+  }
+  diagnose::DiagnoseReport report;
+  diagnose::Diagnose(o, nominal, spec.get(), ident, valid, &report);
+  if (!report.ok) throw InputError("diagnose: " + report.message);
+  const auto files = diagnose::WriteReport(report, ident, valid, p.out);
+  fmt::print("{}\n", report.message);
+  if (!report.findings.empty()) {
+    fmt::print("ranked candidates (score; held-out z, validation z):");
+    for (std::size_t i = 0; i < report.findings.size() && i < 5; ++i) {
+      const auto& f = report.findings[i];
+      fmt::print(" {} {:.3f} ({:.1f}, {:.1f}){}", f.Label(), f.score, f.holdout.z, f.validation.z,
+                 i + 1 < std::min<std::size_t>(5, report.findings.size()) ? "," : "\n");
+    }
+  }
+  fmt::print("baseline: {}; {}\n", report.baseline_source, report.initial_state_note);
+  fmt::print("wrote {} files to {} ({:.2f} s)\n", files.size(), p.out, report.seconds);
+}
+
+}  // namespace
 
 void AddDiagnoseCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "diagnose",
       "Find where a model's simulation differs from a recording, name the missing effect, refit, validate");
-  struct Opts {
-    std::string data, validate, model, fit, out, u_col = "u", y_col = "y", t_col = "t", effects;
-    diagnose::DiagnoseOptions o;
-  };
-  auto o = std::make_shared<Opts>();
-  cmd->add_option("--data", o->data, "identification recording (CSV with header, or FILE.mat:u=VAR,y=VAR[,t=VAR])")
-      ->required();
-  cmd->add_option("--validate", o->validate, "validation recording (CSV or .mat, as --data)")->required();
-  auto* m = cmd->add_option("--model", o->model, "nominal model JSON (README: Model JSON)");
-  auto* f = cmd->add_option("--fit", o->fit, "fit the nominal model first: linear:NA,NB[,DELAY] or hw:NA,NB,PIN,POUT[,DELAY]");
+  auto p = std::make_shared<Opts>();
+  cmd->add_option("--data", p->data, "identification recording: FILE or FILE:u=NAME,y=NAME[,t=NAME]")->required();
+  cmd->add_option("--validate", p->validate, "validation recording: FILE or FILE:u=NAME,y=NAME[,t=NAME]")->required();
+  auto* m = cmd->add_option("--model", p->model, "nominal model JSON (README: Model JSON)");
+  auto* f = cmd->add_option("--fit", p->fit, "fit the nominal model first: linear:NA,NB[,DELAY] or hw:NA,NB,PIN,POUT[,DELAY]");
   m->excludes(f);
-  cmd->add_option("--out", o->out, "output directory (report.json, report.md, figures)")->required();
-  cmd->add_option("--u-col", o->u_col, "input column");
-  cmd->add_option("--y-col", o->y_col, "output column");
-  cmd->add_option("--t-col", o->t_col, "time column (sample index when absent)");
-  cmd->add_option("--noise-std", o->o.noise_std, "output noise standard deviation")->default_str("estimated");
-  cmd->add_option("--init-samples", o->o.init_samples, "leading samples excluded from costs (transient from rest)");
-  cmd->add_option("--holdout", o->o.holdout_fraction, "fraction of the identification recording held out for ranking");
-  cmd->add_option("--min-improvement", o->o.min_improvement, "minimum penalised MSE reduction for a verdict");
-  cmd->add_option("--significance-z", o->o.significance_z, "held-out paired z pre-screen");
-  cmd->add_option("--validation-z", o->o.validation_z, "validation paired z required for a verdict");
-  cmd->add_option("--window", o->o.windows.length, "mismatch window length in samples (0 = auto)")->default_str("auto");
-  cmd->add_option("--effects", o->effects, "comma-separated candidates EFFECT@LOCATION")->default_str("all");
-  cmd->callback([o] {
-    CheckOutputDirectory(o->out, "--out");
-    if (o->model.empty() == o->fit.empty()) throw InputError("diagnose needs exactly one of --model FILE or --fit SPEC");
-    std::string err;
-    if (!o->o.IsValid(&err)) throw InputError("diagnose: " + err);
-    if (!o->effects.empty()) o->o.candidates = diagnose::ParseCandidates(o->effects);
-    const auto ident = diagnose::LoadRecording(o->data, o->u_col, o->y_col, o->t_col);
-    const auto valid = diagnose::LoadRecording(o->validate, o->u_col, o->y_col, o->t_col);
-    HwModel nominal;
-    if (!o->model.empty()) {
-      nominal = HwModel::load(o->model);
-    } else {
-      const auto spec = diagnose::NominalSpec::Parse(o->fit);
-      nominal = diagnose::FitNominal(spec, {&ident.u, &ident.y, o->o.init_samples});
-    }
-    diagnose::DiagnoseReport report;
-    diagnose::Diagnose(o->o, nominal, ident, valid, &report);
-    if (!report.ok) throw InputError("diagnose: " + report.message);
-    const auto files = diagnose::WriteReport(report, ident, valid, o->out);
-    fmt::print("{}\n", report.message);
-    if (!report.findings.empty()) {
-      fmt::print("ranked candidates (held-out score, z):");
-      for (std::size_t i = 0; i < report.findings.size() && i < 4; ++i)
-        fmt::print(" {}@{} {:.3f} ({:.1f}){}", diagnose::EffectName(report.findings[i].block.effect),
-                   diagnose::LocationName(report.findings[i].block.location), report.findings[i].score,
-                   report.findings[i].z, i + 1 < std::min<std::size_t>(4, report.findings.size()) ? "," : "");
-      fmt::print("\n");
-    }
-    fmt::print("wrote {} files to {} ({:.2f} s)\n", files.size(), o->out, report.seconds);
+  cmd->add_option("--out", p->out, "output directory (report.json, report.md, figures)")->required();
+  auto* tc = cmd->add_option("--t-col", p->ident_cols.t, "time column (sample index when absent)");
+  cmd->add_option("--u-col", p->ident_cols.u, "input column (both recordings unless --validate-u-col)");
+  cmd->add_option("--y-col", p->ident_cols.y, "output column (both recordings unless --validate-y-col)");
+  auto* vu = cmd->add_option("--validate-u-col", p->valid_cols.u, "input column of the validation recording");
+  auto* vy = cmd->add_option("--validate-y-col", p->valid_cols.y, "output column of the validation recording");
+  auto* vt = cmd->add_option("--validate-t-col", p->valid_cols.t, "time column of the validation recording");
+  cmd->add_option("--noise-std", p->o.noise_std, "output noise standard deviation")->default_str("estimated");
+  cmd->add_option("--init-samples", p->o.init_samples, "leading samples excluded from costs (warm-up)");
+  cmd->add_flag("--no-initial-state", p->no_initial_state,
+                "simulate from rest instead of estimating the initial state of each recording");
+  cmd->add_option("--holdout", p->o.holdout_fraction, "fraction of the identification recording held out for ranking");
+  cmd->add_option("--min-improvement", p->o.min_improvement, "minimum penalised MSE reduction for a verdict");
+  cmd->add_option("--significance-z", p->o.significance_z, "held-out paired z required");
+  cmd->add_option("--validation-z", p->o.validation_z, "validation paired z required for a verdict");
+  cmd->add_option("--window", p->o.windows.length, "window length of the residual test in samples (0 = auto)")->default_str("auto");
+  cmd->add_option("--window-alpha", p->o.windows.alpha, "family-wise false-alarm probability of the residual windows");
+  cmd->add_option("--effects", p->effects, "comma-separated candidates EFFECT@LOCATION")->default_str("all");
+  cmd->add_option("--state-variable", p->state_variable,
+                  "what the linear block's output is: position or velocity (force -> velocity drives)");
+  cmd->add_flag("--no-pairs", p->no_pairs, "do not try combinations of two blocks");
+  cmd->add_option("--threads", p->o.threads, "parallel candidate fits (0 = all cores)");
+  cmd->callback([p, cmd, tc, vu, vy, vt] {
+    // Validation columns default to the identification ones unless named.
+    if (!vu->count()) p->valid_cols.u = p->ident_cols.u;
+    if (!vy->count()) p->valid_cols.y = p->ident_cols.y;
+    if (!vt->count()) p->valid_cols.t = p->ident_cols.t;
+    (void)cmd;
+    Run(*p, tc->count() > 0, vt->count() > 0 || tc->count() > 0);
   });
 }
 

@@ -1,10 +1,15 @@
 #include "diagnose/diagnose.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+#include "diagnose/locate.hpp"
 
 namespace hw::diagnose {
 namespace {
@@ -29,11 +34,10 @@ double Mse(const Vec& e, std::size_t from, std::size_t to) {
   return to > from ? s / (to - from) : 0.0;
 }
 
-// Batch-means z statistic of mean(d) > 0 on [from, to): batches absorb the residual's colour.
+// Batch-means z statistic of mean(e0^2 - e1^2) > 0 on [from, to): batches absorb the residual's colour.
 double PairedZ(const Vec& e0, const Vec& e1, std::size_t from, std::size_t to, int batch) {
   const std::size_t n = to > from ? to - from : 0;
-  const std::size_t nbatch = std::max<std::size_t>(1, n / std::max(batch, 1));
-  if (nbatch < 5) batch = static_cast<int>(std::max<std::size_t>(1, n / 5));
+  if (n / std::max(batch, 1) < 5) batch = static_cast<int>(std::max<std::size_t>(1, n / 5));
   Vec means;
   for (std::size_t s = from; s + batch <= to; s += batch) {
     double m = 0.0;
@@ -52,12 +56,238 @@ double PairedZ(const Vec& e0, const Vec& e1, std::size_t from, std::size_t to, i
   return mean / se;
 }
 
-std::string ParamText(const EffectBlock& b) {
+// Runs f(0..n-1) on up to `threads` threads; each index is independent.
+template <class F>
+void ParallelFor(std::size_t n, int threads, F f) {
+  const std::size_t want = threads > 0 ? static_cast<std::size_t>(threads)
+                                       : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+  const std::size_t k = std::min(want, n);
+  if (k <= 1) {
+    for (std::size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  std::vector<std::thread> pool;
+  for (std::size_t w = 0; w < k; ++w)
+    pool.emplace_back([&] {
+      for (std::size_t i = next++; i < n; i = next++) f(i);
+    });
+  for (auto& t : pool) t.join();
+}
+
+std::string ParamText(const AugmentedModel& m) {
   std::string s;
-  const auto names = ParameterNames(b.effect);
-  for (std::size_t i = 0; i < names.size() && i < b.params.size(); ++i)
-    s += fmt::format("{}{} = {:.4g}", s.empty() ? "" : ", ", names[i], b.params[i]);
+  for (const auto& b : m.blocks) s += fmt::format("{}{} ({})", s.empty() ? "" : " + ", b.Label(), ParameterText(b, m));
   return s;
+}
+
+// Shared state of one diagnosis: the recordings, their parts and the comparison settings.
+struct Context {
+  const DiagnoseOptions& o;
+  const Recording& ident;
+  const Recording& valid;
+  std::size_t skip = 0, n = 0, nfit = 0, nv = 0;
+  int batch = 8;
+  Segment fit, full, validation;
+
+  Context(const DiagnoseOptions& opt, const Recording& id, const Recording& va) : o(opt), ident(id), valid(va) {
+    skip = o.init_samples;
+    n = ident.y.size();
+    nv = valid.y.size();
+    nfit = skip + static_cast<std::size_t>((n - skip) * (1.0 - o.holdout_fraction));
+    batch = o.windows.Resolve(n);
+    fit = {&ident.u, &ident.y, skip, nfit};
+    full = {&ident.u, &ident.y, skip, 0};
+    validation = {&valid.u, &valid.y, skip, 0};
+  }
+  // Residual on the validation recording of a fixed model, its initial state re-estimated there.
+  Vec ValidationResidual(AugmentedModel m) const {
+    EstimateInitialState(&m, validation, o.refit);
+    return Residual(valid.y, m.simulate(valid.u));
+  }
+  Vec IdentResidual(const AugmentedModel& m) const { return Residual(ident.y, m.simulate(ident.u)); }
+  // Penalty factor for k extra parameters scored on ns samples: FPE on the fitting part, BIC-like on the scored part.
+  double Penalty(int k, std::size_t ns) const {
+    const double nf = static_cast<double>(nfit - skip), nsd = static_cast<double>(std::max<std::size_t>(ns, 2));
+    return std::exp(k * std::log(nsd) / nsd) * (nf + k) / std::max(nf - k, 1.0);
+  }
+  Comparison Compare(const Vec& e0, const Vec& e1, std::size_t from, std::size_t to, int k, double z_needed) const {
+    Comparison c;
+    c.mse = Mse(e1, from, to);
+    c.mse_baseline = Mse(e0, from, to);
+    c.ratio = c.mse / std::max(c.mse_baseline, 1e-300);
+    c.score = 1.0 - c.ratio * Penalty(k, to - from);
+    c.z = PairedZ(e0, e1, from, to, batch);
+    c.significant = c.z >= z_needed && c.score >= o.min_improvement;
+    return c;
+  }
+};
+
+// What a candidate is compared against: a model fitted on the fitting part and its residuals.
+struct Reference {
+  AugmentedModel fitted;  // on the fitting part
+  Vec ident_residual;     // of `fitted` on the identification recording
+  Vec valid_residual;     // of the reference refitted on the whole identification recording
+};
+
+Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
+  // Saturation-type blocks: one-sided and two-sided limits are different structures, chosen by the
+  // penalised held-out score (a second limit must earn its parameter).
+  std::vector<LimitSides> variants = {LimitSides::kAny};
+  if (effect == Effect::kSaturation || effect == Effect::kStateSaturation)
+    variants = {LimitSides::kUpper, LimitSides::kLower, LimitSides::kBoth};
+  Finding f;
+  bool have = false;
+  for (const LimitSides sides : variants) {
+    const RefitResult fit = AddBlock(ref.fitted, effect, location, c.o.state_variable, c.fit, c.o.refit, sides);
+    if (fit.model.blocks.size() <= ref.fitted.blocks.size()) continue;
+    const int k = fit.extra_parameters - EffectParameterCount(ref.fitted);
+    const Comparison h = c.Compare(ref.ident_residual, c.IdentResidual(fit.model), c.nfit, c.n, k, c.o.significance_z);
+    if (have && h.score <= f.holdout.score) continue;
+    have = true;
+    f.fitted = fit.model;
+    f.blocks = fit.model.blocks;
+    f.extra_parameters = k;
+    f.holdout = h;
+  }
+  if (!have) return f;
+  f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
+  const Vec v1 = c.ValidationResidual(f.model);
+  f.validation = c.Compare(ref.valid_residual, v1, c.skip, c.nv, f.extra_parameters, c.o.validation_z);
+  const double ph = std::max(1.0 - f.holdout.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
+  f.score = 1.0 - std::sqrt(ph * pv);
+  f.eligible = f.holdout.significant && f.validation.significant;
+  return f;
+}
+
+void RankFindings(std::vector<Finding>* fs) {
+  std::stable_sort(fs->begin(), fs->end(), [](const Finding& a, const Finding& b) {
+    if (a.eligible != b.eligible) return a.eligible;
+    return a.score > b.score;
+  });
+}
+
+std::string Evidence(const Finding& f) {
+  return fmt::format(
+      "held-out MSE {:.3g}x the baseline's (penalised reduction {:.1f} %, z = {:.1f}); validation MSE {:.3g}x "
+      "(penalised reduction {:.1f} %, z = {:.1f}){}; {}",
+      f.holdout.ratio, 100 * f.holdout.score, f.holdout.z, f.validation.ratio, 100 * f.validation.score,
+      f.validation.z, f.eligible ? "; eligible" : "; not significant on both", ParamText(f.model));
+}
+
+// Baseline: the nominal refitted alone, from the given numbers and (structure known) fresh starts.
+Reference Baseline(const Context& c, const AugmentedModel& nominal, const NominalSpec* structure,
+                   DiagnoseReport* r) {
+  const Segment held{&c.ident.u, &c.ident.y, c.nfit, c.n};
+  auto holdout_rmse = [&](const AugmentedModel& m) { return std::sqrt(SumSquaredError(m, held) / held.Count()); };
+  AugmentedModel best = RefitModel(nominal, c.fit, c.o.refit).model;
+  r->baseline_source = "the given nominal model, refitted";
+  r->baseline_starts.push_back({r->baseline_source, std::sqrt(SumSquaredError(best, c.fit) / c.fit.Count()),
+                                holdout_rmse(best)});
+  NominalSpec spec;
+  if (structure || NominalSpec::Of(nominal.nominal, &spec)) {
+    NominalFitOptions no = c.o.nominal_fit;
+    no.refit = c.o.refit;
+    try {
+      const NominalFit fresh = FitNominal(structure ? *structure : spec, c.fit, no);  // chooses inside the fitting part
+      const double h = holdout_rmse(fresh.model);
+      r->baseline_starts.push_back({"fresh starts: " + fresh.Summary(),
+                                    std::sqrt(SumSquaredError(fresh.model, c.fit) / c.fit.Count()), h});
+      if (h < r->baseline_starts.front().holdout_rmse) {
+        best = fresh.model;
+        r->baseline_source = "fresh starts of the nominal structure (" + fresh.starts[fresh.chosen].name + ")";
+      }
+    } catch (const InputError& e) {  // e.g. too short a fitting part for the structure: keep the refit
+      r->baseline_starts.push_back({std::string("fresh starts not possible: ") + e.what(), HUGE_VAL, HUGE_VAL});
+    }
+  }
+  Reference ref;
+  ref.fitted = best;
+  ref.ident_residual = c.IdentResidual(best);
+  ref.valid_residual = c.ValidationResidual(RefitModel(best, c.full, c.o.refit).model);
+  return ref;
+}
+
+std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
+  const auto candidates = c.o.candidates.empty() ? CandidateEffects() : c.o.candidates;
+  std::vector<Finding> out(candidates.size());
+  ParallelFor(candidates.size(), c.o.threads,
+              [&](std::size_t i) { out[i] = EvaluateAddition(c, base, candidates[i].first, candidates[i].second); });
+  out.erase(std::remove_if(out.begin(), out.end(), [](const Finding& f) { return f.blocks.empty(); }), out.end());
+  for (auto& f : out) f.evidence = Evidence(f);
+  RankFindings(&out);
+  return out;
+}
+
+// Pairs of the verdict with the next-ranked candidates; compared against the verdict alone.
+std::vector<Finding> SearchPairs(const Context& c, const Finding& single, const std::vector<Finding>& ranked) {
+  Reference ref;
+  ref.fitted = single.fitted;
+  ref.ident_residual = c.IdentResidual(ref.fitted);
+  ref.valid_residual = c.ValidationResidual(single.model);
+  std::vector<std::pair<Effect, Location>> partners;
+  for (const auto& f : ranked) {
+    if (static_cast<int>(partners.size()) >= c.o.pair_partners) break;
+    const auto& b = f.blocks.front();
+    if (f.holdout.score <= 0 || (b.effect == single.blocks[0].effect && b.location == single.blocks[0].location))
+      continue;
+    partners.emplace_back(b.effect, b.location);
+  }
+  std::vector<Finding> out(partners.size());
+  ParallelFor(partners.size(), c.o.threads,
+              [&](std::size_t i) { out[i] = EvaluateAddition(c, ref, partners[i].first, partners[i].second); });
+  out.erase(std::remove_if(out.begin(), out.end(), [](const Finding& f) { return f.blocks.size() < 2; }), out.end());
+  for (auto& f : out) f.evidence = Evidence(f) + " (compared with " + single.Label() + " alone)";
+  RankFindings(&out);
+  return out;
+}
+
+// How long the estimated initial state moves the simulation by more than the noise.
+std::string InitialStateNote(const AugmentedModel& m, const Vec& u, double sigma) {
+  if (m.initial_state.empty()) return "the simulation starts from rest";
+  AugmentedModel rest = m;
+  rest.initial_state.assign(m.initial_state.size(), 0.0);
+  const Vec a = m.simulate(u), b = rest.simulate(u);
+  std::size_t last = 0;
+  for (std::size_t t = 0; t < a.size(); ++t)
+    if (std::abs(a[t] - b[t]) > sigma) last = t + 1;
+  std::string z;
+  for (double v : m.initial_state) z += fmt::format("{}{:.4g}", z.empty() ? "" : ", ", v);
+  return last == 0 ? fmt::format("initial state estimated (z_-1.. = {}); the recording starts close to rest", z)
+                   : fmt::format("initial state estimated (z_-1.. = {}); it moves the first {} samples by more than "
+                                 "the noise (these would otherwise inflate the error)", z, last);
+}
+
+void Summarise(DiagnoseReport* rp) {
+  DiagnoseReport& r = *rp;
+  const std::string param_note =
+      r.parameters_off
+          ? fmt::format(" Note: the nominal model's own parameters are off — refitting them alone lowers the "
+                        "validation RMSE from {:.4g} to {:.4g} (paired z = {:.1f}); the baseline every candidate had "
+                        "to beat is that refit ({}).",
+                        r.nominal.rmse, r.nominal_refit.rmse, r.refit_z, r.baseline_source)
+          : "";
+  std::size_t flagged = 0;
+  for (bool m : r.mask) flagged += m;
+  const double frac = r.mask.empty() ? 0.0 : double(flagged) / r.mask.size();
+  std::string per_block;
+  if (r.block_windows.size() > 1) {
+    for (const auto& w : r.block_windows)
+      per_block += fmt::format("{}{} acts in {:.1f} %", per_block.empty() ? " On its own: " : "; ", w.label, 100 * w.fraction);
+    per_block += " of the samples.";
+  }
+  if (r.verdict == Effect::kNone)
+    r.message = fmt::format("verdict: none — {}. Validation RMSE {:.4g} (fit {:.1f} %) for the refitted nominal "
+                            "model; {:.1f} % of the identification samples flagged ({}).",
+                            r.validation_note, r.augmented.rmse, r.augmented.fit_percent, 100 * frac, r.mask_source) +
+                param_note;
+  else
+    r.message = fmt::format(
+        "verdict: {} ({}). Where: {} window(s), {:.1f} % of the identification samples, {}. Validation RMSE {:.4g} "
+        "-> {:.4g} (fit {:.1f} % -> {:.1f} %).",
+        r.augmented_model.Label(), ParamText(r.augmented_model), r.windows.size(), 100 * frac, r.region.description,
+        r.nominal_refit.rmse, r.augmented.rmse, r.nominal_refit.fit_percent, r.augmented.fit_percent) +
+        per_block + param_note;
 }
 
 }  // namespace
@@ -72,209 +302,160 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!(significance_z > 0) || !(validation_z >= 0)) return fail("significance_z > 0 and validation_z >= 0 required");
   if (!(min_improvement >= 0 && min_improvement < 1)) return fail("min_improvement must be in [0, 1)");
   if (max_lag < 1) return fail("max_lag must be >= 1");
-  if (max_validated < 1) return fail("max_validated must be >= 1");
-  return windows.IsValid(error) && refit.IsValid(error);
+  if (pair_partners < 0) return fail("pair_partners must be >= 0");
+  if (threads < 0) return fail("threads must be >= 0 (0 = hardware concurrency)");
+  for (const auto& [e, l] : candidates)
+    if (!IsDefined(e, l)) return fail(fmt::format("candidate {}@{} is not defined", EffectName(e), LocationName(l)));
+  return windows.IsValid(error) && refit.IsValid(error) && nominal_fit.IsValid(error);
 }
 
-nlohmann::json Finding::to_json() const {
-  const auto b = block.to_json();
-  return {{"effect", b["effect"]},
-          {"location", b["location"]},
-          {"parameters", b["parameters"]},
-          {"score", score},
-          {"evidence",
-           {{"text", evidence},
-            {"holdout_mse", holdout_mse},
-            {"holdout_mse_nominal", holdout_mse_nominal},
-            {"mse_ratio", mse_ratio},
-            {"z", z},
-            {"extra_parameters", extra_parameters},
-            {"share_of_improvement_in_mismatch_windows", in_window_share},
-            {"significant", significant}}}};
+nlohmann::json Comparison::to_json() const {
+  return {{"mse", mse}, {"mse_baseline", mse_baseline}, {"mse_ratio", ratio}, {"score", score}, {"z", z},
+          {"significant", significant}};
 }
 
-void Diagnose(const DiagnoseOptions& o, const HwModel& nominal, const Recording& ident, const Recording& valid,
-              DiagnoseReport* rep) {
+std::string Finding::Label() const {
+  std::string s;
+  for (const auto& b : blocks) s += (s.empty() ? "" : "+") + b.Label();
+  return s.empty() ? "none" : s;
+}
+
+namespace {
+
+// Why the inputs cannot be diagnosed, or "" when they can.
+std::string InputProblem(const DiagnoseOptions& o, const AugmentedModel& nominal, const Recording& ident,
+                         const Recording& valid) {
+  std::string err;
+  if (!o.IsValid(&err)) return "invalid options: " + err;
+  if (nominal.has_block()) return "the nominal model already holds effect blocks; diagnose the model without them";
+  if (ident.u.size() != ident.y.size() || valid.u.size() != valid.y.size()) return "u and y must have equal lengths";
+  if (ident.y.size() < o.init_samples + 60 || valid.y.size() < o.init_samples + 30)
+    return fmt::format("recordings too short: need at least {} identification and {} validation samples after the {} "
+                       "initial samples", 60, 30, o.init_samples);
+  return "";
+}
+
+// Noise level: given, or a robust estimate from the residual's differences capped by what the baseline
+// and the eligible candidates reach.
+double NoiseLevel(const Context& c, const Vec& e_nom, const Reference& base, const std::vector<Finding>& findings) {
+  if (c.o.noise_std > 0) return c.o.noise_std;
+  double sigma = std::min(EstimateNoiseStd(e_nom, c.skip), std::sqrt(Mse(base.ident_residual, c.skip, c.nfit)));
+  for (const auto& f : findings)
+    if (f.eligible) sigma = std::min(sigma, std::sqrt(Mse(c.IdentResidual(f.model), c.skip, c.n)));
+  return sigma;
+}
+
+// Figures on both recordings for the given nominal, the nominal refit and the augmented model; returns
+// the validation residuals of the refit and of the augmented model.
+std::pair<Vec, Vec> Figure(const Context& c, const AugmentedModel& nominal, const Finding* verdict, DiagnoseReport* r) {
+  const Vec v_given = c.ValidationResidual(nominal), v_refit = c.ValidationResidual(r->nominal_refit_model);
+  auto sim_of = [&](const Vec& e) {
+    Vec s(c.valid.y.size());
+    for (std::size_t t = 0; t < s.size(); ++t) s[t] = c.valid.y[t] - e[t];
+    return s;
+  };
+  r->valid_nominal_sim = sim_of(v_given);
+  r->nominal = Figures(c.valid.y, r->valid_nominal_sim, c.skip);
+  r->nominal_refit = Figures(c.valid.y, sim_of(v_refit), c.skip);
+  r->refit_z = PairedZ(v_given, v_refit, c.skip, c.nv, c.batch);
+  r->parameters_off = r->refit_z >= c.o.validation_z && r->nominal_refit.rmse * r->nominal_refit.rmse <=
+                                                            (1.0 - c.o.min_improvement) * r->nominal.rmse * r->nominal.rmse;
+  r->augmented_model = verdict ? verdict->model : r->nominal_refit_model;
+  const Vec v_aug = c.ValidationResidual(r->augmented_model);
+  r->valid_augmented_sim = sim_of(v_aug);
+  r->augmented = Figures(c.valid.y, r->valid_augmented_sim, c.skip);
+  r->ident_augmented_sim = r->augmented_model.simulate(c.ident.u);
+  r->ident_nominal = Figures(c.ident.y, r->ident_nominal_sim, c.skip);
+  r->ident_augmented = Figures(c.ident.y, r->ident_augmented_sim, c.skip);
+  return {v_refit, v_aug};
+}
+
+void Conclude(const Context& c, const Finding* verdict, DiagnoseReport* r) {
+  if (verdict) {
+    r->verdict_blocks = verdict->model.blocks;
+    r->verdict = r->verdict_blocks.front().effect;
+    r->verdict_location = r->verdict_blocks.front().location;
+    r->validation_z = verdict->validation.z;
+    r->validation_note = fmt::format("validation confirms {}: paired z = {:.1f} >= {:.1f}, MSE {:.3g}x the baseline's",
+                                     verdict->Label(), verdict->validation.z, c.o.validation_z, verdict->validation.ratio);
+    return;
+  }
+  int held = 0;
+  for (const auto& f : r->findings) held += f.holdout.significant;
+  r->validation_note = held == 0 ? "no candidate improved the held-out identification tail significantly"
+                                 : fmt::format("{} candidate(s) improved the held-out tail but none the validation "
+                                               "recording as well (paired z >= {:.1f} and >= {:.0f} % MSE reduction)",
+                                               held, c.o.validation_z, 100 * c.o.min_improvement);
+}
+
+// Windows: where the verdict's blocks change the prediction, or (no verdict) where the refitted
+// nominal's residual exceeds the noise; their operating region.
+void Locate(const Context& c, bool verdict, const Vec& e_nom, const Vec& v_refit, DiagnoseReport* r) {
+  const double sigma = r->noise_std;
+  r->conditions = OperatingConditions(c.ident.u, r->nominal_refit_model.simulate(c.ident.u));
+  r->residual_mask = MismatchMask(e_nom, sigma, c.skip, c.o.windows);
+  Vec weight;
+  if (verdict) {
+    r->mask = BlockEffectMask(r->augmented_model, c.ident.u, sigma, c.skip, &weight);
+    r->block_windows = PerBlockMasks(r->augmented_model, c.ident.u, sigma, c.skip);
+    r->mask_source = "samples where the verdict's blocks change the prediction by more than the noise";
+    r->validation_windows = MaskToWindows(BlockEffectMask(r->augmented_model, c.valid.u, sigma, c.skip, nullptr));
+  } else {
+    weight = c.IdentResidual(r->nominal_refit_model);
+    r->mask = MismatchMask(weight, sigma, c.skip, c.o.windows);
+    r->mask_source = "samples where the refitted nominal's local mean-square error exceeds the noise";
+    r->validation_windows = MaskToWindows(MismatchMask(v_refit, sigma, c.skip, c.o.windows));
+  }
+  r->windows = MaskToWindows(r->mask);
+  r->region = CharacteriseRegion(r->conditions, r->mask, weight, c.skip, verdict ? "change" : "error");
+}
+
+}  // namespace
+
+void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const NominalSpec* structure,
+              const Recording& ident, const Recording& valid, DiagnoseReport* rep) {
   const auto start = std::chrono::steady_clock::now();
   DiagnoseReport& r = *rep;
   r = DiagnoseReport{};
-  std::string err;
-  if (!o.IsValid(&err)) {
-    r.message = "invalid options: " + err;
-    return;
-  }
-  const std::size_t n = ident.y.size(), skip = o.init_samples;
-  if (ident.u.size() != n || valid.u.size() != valid.y.size()) {
-    r.message = "u and y must have equal lengths";
-    return;
-  }
-  if (n < skip + 60 || valid.y.size() < skip + 30) {
-    r.message = fmt::format("recordings too short: need at least {} identification and {} validation samples after "
-                            "the {} initial samples", 60, 30, skip);
-    return;
-  }
+  r.message = InputProblem(o, nominal, ident, valid);
+  if (!r.message.empty()) return;
+  const Context c(o, ident, valid);
   r.nominal_model = nominal;
 
-  // 1. Locate.
-  r.ident_nominal_sim = nominal.simulate(ident.u);
+  // The nominal model as given (its initial state estimated on each recording).
+  AugmentedModel given = nominal;
+  EstimateInitialState(&given, c.full, o.refit);
+  r.ident_nominal_sim = given.simulate(ident.u);
   const Vec e_nom = Residual(ident.y, r.ident_nominal_sim);
-  for (double v : e_nom)
-    if (!std::isfinite(v)) {
-      r.message = "the nominal model's simulation is not finite on the identification recording (unstable model?)";
-      return;
-    }
+  if (!std::all_of(e_nom.begin(), e_nom.end(), [](double v) { return std::isfinite(v); })) {
+    r.message = "the nominal model's simulation is not finite on the identification recording (unstable model?)";
+    return;
+  }
+  r.whiteness_nominal = WhitenessTest(e_nom, c.skip, o.max_lag);
+  r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, c.skip, o.max_lag);
+
+  // Baseline, every single block, and a combination of two when it beats the best single one.
+  const Reference base = Baseline(c, nominal, structure, &r);
+  r.findings = SearchSingles(c, base);
+  r.nominal_refit_model = RefitModel(base.fitted, c.full, o.refit).model;
   r.noise_estimated = !(o.noise_std > 0);
-  r.noise_std = r.noise_estimated ? EstimateNoiseStd(e_nom, skip) : o.noise_std;
-  r.conditions = OperatingConditions(ident.u, r.ident_nominal_sim);
-  r.whiteness_nominal = WhitenessTest(e_nom, skip, o.max_lag);
-  r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, skip, o.max_lag);
+  r.noise_std = NoiseLevel(c, e_nom, base, r.findings);
+  const Finding* verdict = !r.findings.empty() && r.findings.front().eligible ? &r.findings.front() : nullptr;
+  if (verdict && o.try_pairs && o.pair_partners > 0) {
+    r.pairs = SearchPairs(c, *verdict, r.findings);
+    if (!r.pairs.empty() && r.pairs.front().eligible) verdict = &r.pairs.front();
+  }
 
-  // 2. Name: rank candidates on the held-out tail of the identification recording.
-  const std::size_t nfit = skip + static_cast<std::size_t>((n - skip) * (1.0 - o.holdout_fraction));
-  const Vec ufit(ident.u.begin(), ident.u.begin() + nfit), yfit(ident.y.begin(), ident.y.begin() + nfit);
-  const Segment fitseg{&ufit, &yfit, skip};
-  const int batch = o.windows.Resolve(n);
-  const RefitResult base = RefitNominal(nominal, fitseg, o.refit);
-  const Vec e_base = Residual(ident.y, base.model.simulate(ident.u));
-  const double mse_base = Mse(e_base, nfit, n);
-  const auto candidates = o.candidates.empty() ? CandidateEffects() : o.candidates;
-  const double nf = static_cast<double>(nfit - skip);
-  std::vector<Vec> residuals;  // per finding, on the whole identification recording
-  for (const auto& [effect, location] : candidates) {
-    const RefitResult fit =
-        RefitWithEffect(base.model.nominal, effect, location, fitseg, o.refit, base.model.output_offset);
-    if (fit.model.block.effect == Effect::kNone) continue;
-    const Vec e1 = Residual(ident.y, fit.model.simulate(ident.u));
-    Finding f;
-    f.block = fit.model.block;
-    f.extra_parameters = fit.extra_parameters;
-    f.holdout_mse = Mse(e1, nfit, n);
-    f.holdout_mse_nominal = mse_base;
-    f.mse_ratio = f.holdout_mse / std::max(mse_base, 1e-300);
-    const double k = f.extra_parameters;
-    const double nh = static_cast<double>(n - nfit);
-    f.score = 1.0 - f.mse_ratio * std::exp(k * std::log(nh) / nh) * (nf + k) / std::max(nf - k, 1.0);
-    f.z = PairedZ(e_base, e1, nfit, n, batch);
-    f.significant = f.z >= o.significance_z && f.score >= o.min_improvement;
-    residuals.push_back(e1);
-    r.findings.push_back(f);
-  }
-  // The noise level is at most the RMS error of the best significant candidate on its fitting part:
-  // the differences-based estimate alone is inflated when the model error is not smooth.
-  double best_fit_rms = HUGE_VAL;
-  for (std::size_t i = 0; i < r.findings.size(); ++i)
-    if (r.findings[i].significant) {
-      double s2 = 0.0;
-      for (std::size_t t = skip; t < nfit; ++t) s2 += residuals[i][t] * residuals[i][t];
-      best_fit_rms = std::min(best_fit_rms, std::sqrt(s2 / std::max<std::size_t>(1, nfit - skip)));
-    }
-  if (r.noise_estimated) r.noise_std = std::min(r.noise_std, best_fit_rms);
-  r.mask = MismatchMask(e_nom, r.noise_std, skip, o.windows);
-  r.windows = MaskToWindows(r.mask);
-  r.region = CharacteriseRegion(r.conditions, r.mask, e_nom, skip);
-  for (std::size_t i = 0; i < r.findings.size(); ++i) {
-    Finding& f = r.findings[i];
-    const Vec& e1 = residuals[i];
-    double in = 0.0, all = 0.0;
-    for (std::size_t t = nfit; t < n; ++t) {
-      const double d = e_base[t] * e_base[t] - e1[t] * e1[t];
-      all += d;
-      if (r.mask[t]) in += d;
-    }
-    f.in_window_share = all > 0 ? in / all : 0.0;
-    f.evidence = fmt::format(
-        "held-out MSE {:.3g}x the refitted nominal's (penalised reduction {:.1f} %, z = {:.1f}{}); {:.0f} % of the "
-        "reduction falls in the mismatch windows; {}",
-        f.mse_ratio, 100 * f.score, f.z, f.significant ? ", significant" : ", not significant",
-        100 * f.in_window_share, ParamText(f.block));
-  }
-  std::sort(r.findings.begin(), r.findings.end(), [](const Finding& a, const Finding& b) {
-    if (a.significant != b.significant) return a.significant;
-    return a.score > b.score;
-  });
-
-  // 3. Refit on the whole identification recording and check on validation.
-  const Segment full{&ident.u, &ident.y, skip};
-  const RefitResult nom_full = RefitNominal(nominal, full, o.refit);
-  r.nominal_refit_model = nom_full.model.nominal;
-  r.nominal_refit_offset = nom_full.model.output_offset;
-  r.valid_nominal_sim = nominal.simulate(valid.u);
-  const Vec v_refit = nom_full.model.simulate(valid.u);
-  r.nominal = Figures(valid.y, r.valid_nominal_sim, skip);
-  r.nominal_refit = Figures(valid.y, v_refit, skip);
-  {
-    // Parameters of the given model off (e.g. a design model): the refit alone improves validation.
-    const Vec e0 = Residual(valid.y, r.valid_nominal_sim), e1 = Residual(valid.y, v_refit);
-    r.refit_z = PairedZ(e0, e1, skip, valid.y.size(), batch);
-    r.parameters_off = r.refit_z >= o.validation_z &&
-                       r.nominal_refit.rmse * r.nominal_refit.rmse <= (1.0 - o.min_improvement) * r.nominal.rmse * r.nominal.rmse;
-  }
-  // The comparison baseline is the better of the given and the refitted nominal model.
-  const bool refit_better = r.nominal_refit.rmse < r.nominal.rmse;
-  const Vec& v_base = refit_better ? v_refit : r.valid_nominal_sim;
-  r.augmented_model = nom_full.model;
-  r.valid_augmented_sim = v_base;
-  r.augmented = refit_better ? r.nominal_refit : r.nominal;
-  r.ident_augmented_sim = refit_better ? nom_full.model.simulate(ident.u) : r.ident_nominal_sim;
-  // Significant candidates are confirmed on validation in rank order (at most max_validated): near-tied
-  // blocks (e.g. saturation at input, output or in the state) can differ in how they extrapolate.
-  std::string rejected;
-  int tried = 0;
-  for (const Finding& best : r.findings) {
-    if (!best.significant || tried >= o.max_validated) break;
-    ++tried;
-    RefitResult aug = RefitWithEffect(nom_full.model.nominal, best.block.effect, best.block.location, full, o.refit,
-                                      nom_full.model.output_offset);
-    const Vec v_aug = aug.model.simulate(valid.u);
-    const FitFigures fa = Figures(valid.y, v_aug, skip);
-    const Vec e0 = Residual(valid.y, v_base), e1 = Residual(valid.y, v_aug);
-    const double z = PairedZ(e0, e1, skip, valid.y.size(), batch);
-    const auto b = aug.model.block;
-    if (b.effect != Effect::kNone && z >= o.validation_z &&
-        fa.rmse * fa.rmse <= (1.0 - o.min_improvement) * r.augmented.rmse * r.augmented.rmse) {
-      r.validation_z = z;
-      r.verdict = b.effect;
-      r.verdict_location = b.location;
-      r.augmented_model = aug.model;
-      r.augmented = fa;
-      r.valid_augmented_sim = v_aug;
-      r.ident_augmented_sim = aug.model.simulate(ident.u);
-      r.validation_note = fmt::format("{}validation confirms {}@{}: paired z = {:.1f} >= {:.1f}", rejected,
-                                      EffectName(b.effect), LocationName(b.location), z, o.validation_z);
-      break;
-    }
-    rejected += fmt::format("{}@{} improved the held-out identification tail but not the validation recording (paired "
-                            "z = {:.1f}, needed {:.1f} and an MSE reduction of at least {:.0f} %); ",
-                            EffectName(best.block.effect), LocationName(best.block.location), z, o.validation_z,
-                            100 * o.min_improvement);
-  }
-  if (r.verdict == Effect::kNone)
-    r.validation_note = tried == 0 ? "no candidate improved the held-out identification tail significantly"
-                                   : rejected + "verdict none";
-  r.ident_nominal = Figures(ident.y, r.ident_nominal_sim, skip);
-  r.ident_augmented = Figures(ident.y, r.ident_augmented_sim, skip);
-  const Vec e_aug_valid = Residual(valid.y, r.valid_augmented_sim);
-  r.whiteness_augmented = WhitenessTest(e_aug_valid, skip, o.max_lag);
-  r.input_corr_augmented = InputCorrelationTest(e_aug_valid, valid.u, skip, o.max_lag);
-  r.validation_windows =
-      MaskToWindows(MismatchMask(Residual(valid.y, r.valid_nominal_sim), r.noise_std, skip, o.windows));
+  const auto [v_refit, v_aug] = Figure(c, nominal, verdict, &r);
+  Conclude(c, verdict, &r);
+  Locate(c, verdict != nullptr, e_nom, v_refit, &r);
+  for (auto& f : r.findings)
+    f.in_window_share = ImprovementShareIn(r.residual_mask, base.ident_residual, c.IdentResidual(f.fitted), c.nfit, c.n);
+  r.initial_state_note = InitialStateNote(r.nominal_refit_model, ident.u, r.noise_std);
+  r.whiteness_augmented = WhitenessTest(v_aug, c.skip, o.max_lag);
+  r.input_corr_augmented = InputCorrelationTest(v_aug, valid.u, c.skip, o.max_lag);
   r.ok = true;
-  const std::string param_note =
-      r.parameters_off
-          ? fmt::format(" Note: the nominal model's own parameters are off — re-estimating them alone (with an "
-                        "output offset, estimated {:.4g}) lowers the validation RMSE from {:.4g} to {:.4g} (paired z = {:.1f}).",
-                        r.nominal_refit_offset, r.nominal.rmse, r.nominal_refit.rmse, r.refit_z)
-          : "";
-  if (r.verdict == Effect::kNone)
-    r.message = fmt::format("verdict: none — {}. Validation RMSE {:.4g} (fit {:.1f} %) for the nominal model.",
-                            r.validation_note, r.nominal.rmse, r.nominal.fit_percent) + param_note;
-  else
-    r.message = fmt::format(
-        "verdict: {} at {} ({}). Mismatch: {} window(s), {}. Validation RMSE {:.4g} -> {:.4g} (fit {:.1f} % -> {:.1f} "
-        "%).",
-        EffectName(r.verdict), LocationName(r.verdict_location), ParamText(r.augmented_model.block), r.windows.size(),
-        r.region.description, std::min(r.nominal.rmse, r.nominal_refit.rmse), r.augmented.rmse,
-        std::max(r.nominal.fit_percent, r.nominal_refit.fit_percent), r.augmented.fit_percent) + param_note;
+  Summarise(&r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

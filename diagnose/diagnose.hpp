@@ -3,22 +3,25 @@
 // physical effect did it leave out, and does inserting that effect improve held-out data?
 //
 // Procedure (Diagnose):
-//  1. Locate — simulate the nominal model on the identification recording; estimate the noise level
-//     (given, or robustly from the residual's differences); flag windows whose local mean-square error
-//     exceeds the noise; find the operating condition (level, rate, time since reversal of u or y) that
-//     best characterises them; run Ljung's whiteness and input cross-correlation tests.
-//  2. Name — split the identification recording into a fitting part and a held-out tail. Refit the
-//     nominal model alone (baseline) and the nominal model with each candidate block (effects.hpp) on
-//     the fitting part; score each on the held-out tail by the MSE ratio to the baseline, penalised by
-//     for its k extra parameters by the FPE factor (Nf+k)/(Nf-k) of the fitting part and the BIC-like
-//     factor exp(k ln Nh / Nh) of the held-out part (so that among equally good blocks the one with
-//     fewer parameters wins), and test the per-sample squared-error
-//     difference with a batch-means z statistic (robust to coloured residuals). A candidate is
-//     significant when z >= significance_z and the penalised MSE reduction >= min_improvement.
-//  3. Model and refit — the best significant candidate is refitted on the whole identification
-//     recording and must also beat the nominal model on the validation recording (paired z >=
-//     validation_z and an MSE reduction >= min_improvement); if it does not, the next significant
-//     candidates are tried in rank order (at most max_validated); otherwise the verdict is "none".
+//  1. Baseline — the nominal model refitted alone on the fitting part (first 2/3) of the
+//     identification recording, from the given numbers and, when the structure is known, from several
+//     fresh starts (nominal_fit.hpp); the best by held-out error is the baseline every candidate must
+//     beat. A bad nominal fit is therefore never blamed on an effect: the nominal refit is itself a
+//     candidate and is reported as such.
+//  2. Search — every candidate block (effects.hpp) is added to the baseline and refitted on the
+//     fitting part (in parallel), scored on the held-out tail, refitted on the whole identification
+//     recording and scored on the validation recording. Scores are MSE ratios to the baseline,
+//     penalised for the k extra parameters (FPE factor (Nf+k)/(Nf-k) on the fitting part, BIC-like
+//     factor exp(k ln N / N) on each scored part); significance is a batch-means paired z of the
+//     per-sample squared-error reduction (robust to coloured residuals). A candidate is eligible when
+//     it is significant on the held-out tail (z >= significance_z, penalised reduction >=
+//     min_improvement) and on validation (z >= validation_z, reduction >= min_improvement); the
+//     verdict is the eligible candidate with the best combined (geometric-mean) penalised score.
+//  3. Combination — when a verdict exists, pairs of it with the next candidates are tried and kept
+//     only if the pair beats the single block by the same two tests.
+//  4. Locate — the mismatch windows are the samples where the verdict's blocks change the
+//     prediction by more than the noise (model with vs. without the blocks); without a verdict, the
+//     samples where the residual's local mean square exceeds the noise (family-wise threshold).
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,49 +30,54 @@
 
 #include "core/hw_model.hpp"
 #include "diagnose/effects.hpp"
+#include "diagnose/locate.hpp"
+#include "diagnose/nominal_fit.hpp"
+#include "diagnose/recording.hpp"
 #include "diagnose/refit.hpp"
 #include "diagnose/residual_analysis.hpp"
 
 namespace hw::diagnose {
 
-struct Recording {
-  std::string name;
-  std::vector<double> t, u, y;
-};
-
-// A recording from its signals, checked for diagnosis: u, y (and t unless empty: then t is the sample index)
-// equally long, t strictly increasing, at least 60 samples. Throws InputError naming `name` and `t_col`.
-Recording MakeRecording(std::string name, std::vector<double> t, std::vector<double> u, std::vector<double> y,
-                        const std::string& t_col = "t");
-// The recording named by a spec (core/recording.hpp: CSV or FILE.mat:u=..,y=..[,t=..]); t_col is optional.
-Recording LoadRecording(const std::string& spec, const std::string& u_col, const std::string& y_col,
-                        const std::string& t_col);
-
 struct DiagnoseOptions {
-  double noise_std = 0.0;             // 0 = estimate from the nominal residual
-  std::size_t init_samples = 0;       // leading samples excluded from every cost (transient from rest)
+  double noise_std = 0.0;             // 0 = estimate from the residuals
+  std::size_t init_samples = 0;       // leading samples excluded from every cost (warm-up)
   double holdout_fraction = 1.0 / 3;  // tail of the identification recording used for ranking
-  double significance_z = 1.0;        // held-out paired test threshold (a pre-screen; validation decides)
-  double min_improvement = 0.05;      // minimum penalised held-out MSE reduction (fraction)
-  double validation_z = 2.0;          // the verdict must also beat the nominal on validation
-  int max_validated = 3;              // significant candidates tried on validation, in rank order
+  double significance_z = 1.0;        // held-out paired test threshold
+  double min_improvement = 0.05;      // minimum penalised MSE reduction (fraction), held-out and validation
+  double validation_z = 2.0;          // validation paired test threshold
+  bool try_pairs = true;              // combinations of two blocks when one leaves a significant misfit
+  int pair_partners = 3;              // candidates tried as the second block
   int max_lag = 25;                   // lags of the correlation tests
+  int threads = 0;                    // candidate fits in parallel; 0 = hardware concurrency
+  StateVariable state_variable = StateVariable::kPosition;  // what the linear block's output is
   WindowOptions windows;
   RefitOptions refit;
+  NominalFitOptions nominal_fit;      // fresh starts of the baseline (when the structure is known)
   std::vector<std::pair<Effect, Location>> candidates;  // empty = CandidateEffects()
   bool IsValid(std::string* error) const;
 };
 
-struct Finding {
-  EffectBlock block;         // parameters refitted on the fitting part
-  int extra_parameters = 0;
-  double holdout_mse = 0.0, holdout_mse_nominal = 0.0;
-  double mse_ratio = 1.0;    // holdout_mse / holdout_mse_nominal
-  double score = 0.0;        // 1 - penalised ratio: fraction of the nominal held-out MSE removed
-  double z = 0.0;            // batch-means paired z of the squared-error reduction
-  double in_window_share = 0.0;  // share of the error reduction inside the mismatch windows
+// One side (held-out tail or validation recording) of a candidate's comparison with the baseline.
+struct Comparison {
+  double mse = 0.0, mse_baseline = 0.0;
+  double ratio = 1.0;  // mse / mse_baseline
+  double score = 0.0;  // 1 - penalised ratio
+  double z = 0.0;      // batch-means paired z of the squared-error reduction
   bool significant = false;
+  nlohmann::json to_json() const;
+};
+
+struct Finding {
+  AugmentedModel fitted;     // fitted on the fitting part of the identification recording
+  AugmentedModel model;      // refitted on the whole identification recording (blocks + nominal)
+  std::vector<EffectBlock> blocks;  // the candidate's blocks, as fitted on the fitting part
+  int extra_parameters = 0;
+  Comparison holdout, validation;
+  double score = 0.0;        // combined: 1 - sqrt(penalised ratio held-out x penalised ratio validation)
+  bool eligible = false;     // significant on both
+  double in_window_share = 0.0;  // share of the held-out error reduction inside the residual windows
   std::string evidence;
+  std::string Label() const;
   nlohmann::json to_json() const;
 };
 
@@ -81,14 +89,24 @@ struct FitFigures {
 struct DiagnoseReport {
   bool ok = false;
   std::string message;  // one-paragraph summary for a person
-  Effect verdict = Effect::kNone;
+  Effect verdict = Effect::kNone;  // primary block of the verdict
   Location verdict_location = Location::kInput;
-  std::vector<Finding> findings;  // ranked, best first
+  std::vector<EffectBlock> verdict_blocks;  // one, or two for a combination
+  std::vector<Finding> findings;            // single blocks, ranked best first
+  std::vector<Finding> pairs;               // combinations tried, ranked
+  // Baseline: the nominal model refitted alone.
+  std::string baseline_source;              // which start the baseline came from
+  std::vector<NominalStart> baseline_starts;
   double noise_std = 0.0;
   bool noise_estimated = true;
-  std::vector<bool> mask;                                    // identification samples flagged
-  std::vector<std::pair<std::size_t, std::size_t>> windows;  // identification sample windows
+  // Locate: where the verdict's blocks change the prediction (identification recording), or, without
+  // a verdict, where the nominal residual exceeds the noise.
+  std::string mask_source;
+  std::vector<bool> mask;
+  std::vector<std::pair<std::size_t, std::size_t>> windows;
   std::vector<std::pair<std::size_t, std::size_t>> validation_windows;
+  std::vector<bool> residual_mask;          // nominal residual beyond the noise (for the figures)
+  std::vector<BlockWindows> block_windows;  // where each verdict block (each limit) acts on its own
   Region region;
   CorrelationTest whiteness_nominal, input_corr_nominal, whiteness_augmented, input_corr_augmented;
   double validation_z = 0.0;
@@ -97,19 +115,19 @@ struct DiagnoseReport {
   double refit_z = 0.0;         // paired z of that improvement
   FitFigures nominal, nominal_refit, augmented;  // on the validation recording
   FitFigures ident_nominal, ident_augmented;     // on the identification recording
-  HwModel nominal_model, nominal_refit_model;
-  double nominal_refit_offset = 0.0;  // output offset estimated with the nominal refit
-  AugmentedModel augmented_model;  // nominal refit + verdict block (block "none" when no verdict)
+  AugmentedModel nominal_model, nominal_refit_model, augmented_model;
+  std::string initial_state_note;  // what the estimated initial state does to the first samples
   // Signals for plots.
   std::vector<double> ident_nominal_sim, ident_augmented_sim, valid_nominal_sim, valid_augmented_sim;
   std::vector<Condition> conditions;  // on the identification recording
   double seconds = 0.0;
 };
 
-// ident and valid must hold equally long t, u, y. Returns report->ok = false with a message when the
-// inputs cannot be diagnosed (too short, non-finite simulation).
-void Diagnose(const DiagnoseOptions& options, const HwModel& nominal, const Recording& ident, const Recording& valid,
-              DiagnoseReport* report);
+// ident and valid must hold equally long t, u, y. `nominal` must have no effect blocks. When
+// `structure` is given (the nominal's structure, e.g. from --fit), the baseline is also refitted from
+// fresh starts. Returns report->ok = false with a message when the inputs cannot be diagnosed.
+void Diagnose(const DiagnoseOptions& options, const AugmentedModel& nominal, const NominalSpec* structure,
+              const Recording& ident, const Recording& valid, DiagnoseReport* report);
 
 // report.json content (schema in docs/diagnose.md).
 nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const Recording& valid);

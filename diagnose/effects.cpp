@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -24,10 +26,11 @@ const std::vector<EffectInfo>& Infos() {
       {Effect::kRateLimit, "rate_limit", {"max_step"}},
       {Effect::kDelay, "delay", {"samples"}},
       {Effect::kQuantization, "quantization", {"step"}},
-      {Effect::kCoulombFriction, "coulomb_friction", {"fc"}},
+      {Effect::kCoulombFriction, "coulomb_friction", {"level_up", "level_down"}},
       {Effect::kHysteresis, "hysteresis", {"threshold", "height"}},
       {Effect::kCubicStiffness, "cubic_stiffness", {"k3"}},
       {Effect::kStateSaturation, "state_saturation", {"lower", "upper"}},
+      {Effect::kStiction, "stiction", {"static_band", "kinetic_band"}},
       {Effect::kNone, "none", {}},
   };
   return infos;
@@ -40,6 +43,31 @@ const EffectInfo& Info(Effect e) {
 }
 
 double Sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+bool IsLimitPair(Effect e) { return e == Effect::kSaturation || e == Effect::kStateSaturation; }
+
+// Every key of `j` must be in `allowed`; the message names the key, where it is and what is allowed.
+void RequireKnownKeys(const nlohmann::json& j, const std::set<std::string>& allowed, const std::string& where) {
+  if (!j.is_object()) throw InputError(fmt::format("{}: expected a JSON object", where));
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!allowed.count(it.key())) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw InputError(fmt::format("{}: unknown key '{}'; expected only: {}", where, it.key(), list));
+    }
+}
+
+void CheckStaticMapKeys(const nlohmann::json& j, const std::string& where) {
+  RequireKnownKeys(j, {"kind", "coefficients", "x", "y"}, where);
+}
+
+// Coulomb friction on the velocity update: pulled towards 0 by the level of its direction, stuck at 0
+// when it would cross.
+double FrictionStep(double v, double up, double down) {
+  if (v > 0) return std::max(v - up, 0.0);
+  if (v < 0) return std::min(v + down, 0.0);
+  return 0.0;
+}
 
 }  // namespace
 
@@ -56,6 +84,8 @@ std::string LocationName(Location l) {
   }
   return "input";
 }
+
+std::string StateVariableName(StateVariable s) { return s == StateVariable::kVelocity ? "velocity" : "position"; }
 
 std::vector<std::string> EffectVocabulary() {
   std::vector<std::string> v;
@@ -78,6 +108,12 @@ Location ParseLocation(const std::string& name) {
   throw InputError(fmt::format("location '{}' unknown; expected input, output or state", name));
 }
 
+StateVariable ParseStateVariable(const std::string& name) {
+  if (name == "position") return StateVariable::kPosition;
+  if (name == "velocity") return StateVariable::kVelocity;
+  throw InputError(fmt::format("state variable '{}' unknown; expected position or velocity", name));
+}
+
 std::vector<std::string> ParameterNames(Effect e) {
   std::vector<std::string> v;
   for (const char* p : Info(e).params) v.emplace_back(p);
@@ -95,9 +131,52 @@ std::vector<std::pair<Effect, Location>> CandidateEffects() {
   using L = Location;
   return {{E::kBacklash, L::kInput},       {E::kDeadzone, L::kInput},        {E::kSaturation, L::kInput},
           {E::kRateLimit, L::kInput},      {E::kDelay, L::kInput},           {E::kQuantization, L::kInput},
-          {E::kHysteresis, L::kInput},     {E::kDeadzone, L::kOutput},       {E::kSaturation, L::kOutput},
-          {E::kQuantization, L::kOutput},  {E::kCoulombFriction, L::kState}, {E::kCubicStiffness, L::kState},
-          {E::kStateSaturation, L::kState}};
+          {E::kHysteresis, L::kInput},     {E::kStiction, L::kInput},        {E::kDeadzone, L::kOutput},
+          {E::kSaturation, L::kOutput},    {E::kQuantization, L::kOutput},   {E::kCoulombFriction, L::kState},
+          {E::kCubicStiffness, L::kState}, {E::kStateSaturation, L::kState}};
+}
+
+bool IsDefined(Effect e, Location l) {
+  for (const auto& [ce, cl] : CandidateEffects())
+    if (ce == e && cl == l) return true;
+  return false;
+}
+
+void ClampToPhysicalRange(EffectBlock* b) {
+  auto& p = b->params;
+  switch (b->effect) {
+    case Effect::kBacklash:
+    case Effect::kDeadzone:
+      p[0] = std::abs(p[0]);
+      break;
+    case Effect::kRateLimit:
+      p[0] = std::max(std::abs(p[0]), 1e-12);
+      break;
+    case Effect::kQuantization:
+      p[0] = std::max(std::abs(p[0]), 1e-12);
+      break;
+    case Effect::kDelay:
+      p[0] = std::max(1.0, std::round(p[0]));
+      break;
+    case Effect::kSaturation:
+    case Effect::kStateSaturation:
+      if (p[0] > p[1]) std::swap(p[0], p[1]);
+      break;
+    case Effect::kHysteresis:
+      p[0] = std::abs(p[0]);
+      p[1] = std::max(p[1], 0.0);  // a negative relay height is not hysteresis: the block switches off
+      break;
+    case Effect::kCoulombFriction:
+      p[0] = std::max(p[0], 0.0);  // friction never pushes: a level below 0 is held at 0
+      p[1] = std::max(p[1], 0.0);
+      break;
+    case Effect::kStiction:
+      p[0] = std::abs(p[0]);
+      p[1] = std::min(std::abs(p[1]), p[0]);
+      break;
+    default:
+      break;
+  }
 }
 
 std::vector<std::pair<Effect, Location>> ParseCandidates(const std::string& list) {
@@ -109,11 +188,11 @@ std::vector<std::pair<Effect, Location>> ParseCandidates(const std::string& list
     const auto at = tok.find('@');
     if (at == std::string::npos)
       throw InputError(fmt::format("effects: '{}' must be EFFECT@LOCATION, e.g. backlash@input", tok));
-    const std::pair<Effect, Location> block{ParseEffect(tok.substr(0, at)), ParseLocation(tok.substr(at + 1))};
-    const auto all = CandidateEffects();
-    if (std::find(all.begin(), all.end(), block) == all.end())
+    const Effect e = ParseEffect(tok.substr(0, at));
+    const Location l = ParseLocation(tok.substr(at + 1));
+    if (!IsDefined(e, l))
       throw InputError(fmt::format("effects: '{}' is not a defined effect block (see docs/diagnose.md)", tok));
-    out.push_back(block);
+    out.emplace_back(e, l);
     pos = comma + 1;
   }
   return out;
@@ -128,37 +207,46 @@ bool EffectBlock::IsValid(std::string* error) const {
     return fail(fmt::format("effect {} needs {} parameters, got {}", EffectName(effect), ParameterNames(effect).size(),
                             params.size()));
   for (double p : params)
-    if (!std::isfinite(p) && effect != Effect::kSaturation && effect != Effect::kStateSaturation)
+    if (!std::isfinite(p) && !IsLimitPair(effect))
       return fail(fmt::format("effect {}: parameters must be finite", EffectName(effect)));
-  bool allowed = effect == Effect::kNone;
-  for (const auto& [e, l] : CandidateEffects()) allowed = allowed || (e == effect && l == location);
-  if (!allowed) return fail(fmt::format("effect {} is not defined at location {}", EffectName(effect), LocationName(location)));
+  if (effect != Effect::kNone && !IsDefined(effect, location))
+    return fail(fmt::format("effect {} is not defined at location {}", EffectName(effect), LocationName(location)));
+  const std::string n = EffectName(effect);
   switch (effect) {
     case Effect::kBacklash:
     case Effect::kDeadzone:
-      if (params[0] < 0) return fail(EffectName(effect) + ": half_width must be >= 0");
+      if (params[0] < 0) return fail(n + ": half_width must be >= 0");
       break;
     case Effect::kRateLimit:
       if (!(params[0] > 0)) return fail("rate_limit: max_step must be > 0");
       break;
     case Effect::kDelay:
-      if (params[0] < 0 || params[0] != std::round(params[0])) return fail("delay: samples must be an integer >= 0");
+      if (params[0] < 1 || params[0] != std::round(params[0])) return fail("delay: samples must be an integer >= 1");
       break;
     case Effect::kQuantization:
       if (!(params[0] > 0)) return fail("quantization: step must be > 0");
       break;
     case Effect::kSaturation:
     case Effect::kStateSaturation:
-      if (!(params[0] < params[1])) return fail(EffectName(effect) + ": lower must be < upper");
+      if (!(params[0] < params[1])) return fail(n + ": lower must be < upper");
       break;
     case Effect::kHysteresis:
-      if (params[0] < 0) return fail("hysteresis: threshold must be >= 0");
+      if (params[0] < 0 || params[1] < 0) return fail("hysteresis: threshold and height must be >= 0");
+      break;
+    case Effect::kCoulombFriction:
+      if (params[0] < 0 || params[1] < 0) return fail("coulomb_friction: level_up and level_down must be >= 0");
+      break;
+    case Effect::kStiction:
+      if (!(params[1] >= 0 && params[0] >= params[1]))
+        return fail("stiction: needs static_band >= kinetic_band >= 0");
       break;
     default:
       break;
   }
   return true;
 }
+
+std::string EffectBlock::Label() const { return EffectName(effect) + "@" + LocationName(location); }
 
 nlohmann::json EffectBlock::to_json() const {
   nlohmann::json p = nlohmann::json::object();
@@ -169,7 +257,39 @@ nlohmann::json EffectBlock::to_json() const {
     else
       p[names[i]] = params[i] > 0 ? "inf" : "-inf";  // one-sided saturation
   }
-  return {{"effect", EffectName(effect)}, {"location", LocationName(location)}, {"parameters", p}};
+  nlohmann::json j = {{"effect", EffectName(effect)}, {"location", LocationName(location)}, {"parameters", p}};
+  if (location == Location::kState) j["state_variable"] = StateVariableName(state_variable);
+  return j;
+}
+
+EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
+  RequireKnownKeys(e, {"effect", "location", "parameters", "state_variable"}, "effect block");
+  EffectBlock b;
+  try {
+    b.effect = ParseEffect(e.at("effect").get<std::string>());
+    b.location = ParseLocation(e.value("location", "input"));
+    if (e.contains("state_variable")) b.state_variable = ParseStateVariable(e.at("state_variable").get<std::string>());
+    const auto names = ParameterNames(b.effect);
+    const auto& ps = e.at("parameters");
+    RequireKnownKeys(ps, std::set<std::string>(names.begin(), names.end()),
+                     fmt::format("effect block {} parameters", EffectName(b.effect)));
+    for (const auto& n : names) {
+      const auto& v = ps.at(n);
+      if (v.is_string()) {
+        const auto s = v.get<std::string>();
+        if (s != "inf" && s != "-inf")
+          throw InputError(fmt::format("effect block parameter {}: '{}' is not a number, \"inf\" or \"-inf\"", n, s));
+        b.params.push_back(s == "-inf" ? -HUGE_VAL : HUGE_VAL);
+      } else {
+        b.params.push_back(v.get<double>());
+      }
+    }
+  } catch (const nlohmann::json::exception& ex) {
+    throw InputError(fmt::format("effect block: {}", ex.what()));
+  }
+  std::string err;
+  if (!b.IsValid(&err)) throw InputError("effect block: " + err);
+  return b;
 }
 
 double ApplyStaticBlock(const EffectBlock& block, double v) {
@@ -217,62 +337,126 @@ std::vector<double> ApplyInputBlock(const EffectBlock& block, const std::vector<
       }
       break;
     }
+    case Effect::kStiction: {
+      // He, Wang, Pottmann, Qin (2007): stuck until the input has moved more than the static band from
+      // the stem; then the stem follows at the kinetic lag until the input reverses or stops.
+      const double fs = block.params[0], fd = block.params[1];
+      double prev = u[0], dir = 0.0;
+      bool stuck = true;
+      for (std::size_t t = 0; t < n; ++t) {
+        const double d = u[t] - prev;
+        if (stuck && std::abs(d) > fs) {
+          stuck = false;
+          dir = Sign(d);
+        } else if (!stuck && !(Sign(d) == dir && std::abs(d) > fd)) {
+          stuck = true;
+        }
+        prev = x[t] = stuck ? prev : u[t] - dir * fd;
+      }
+      break;
+    }
     default:
       for (std::size_t t = 0; t < n; ++t) x[t] = ApplyStaticBlock(block, u[t]);
   }
   return x;
 }
 
+std::vector<double> ParametersInRecordingUnits(const EffectBlock& b, const AugmentedModel& m) {
+  std::vector<double> p = b.params;
+  if (b.effect == Effect::kStateSaturation && b.location == Location::kState)
+    for (auto& v : p)
+      if (std::isfinite(v)) v = m.nominal.output(v) + m.output_offset;
+  return p;
+}
+
+std::vector<double> FrictionLevelsInInputUnits(const EffectBlock& b, const AugmentedModel& m) {
+  if (b.effect != Effect::kCoulombFriction || m.nominal.input.kind != StaticMap::Kind::kIdentity) return {};
+  double gain = 0.0;
+  for (double v : m.nominal.linear.b) gain += v;
+  if (!(std::abs(gain) > 0)) return {};
+  return {b.params[0] / std::abs(gain), b.params[1] / std::abs(gain)};
+}
+
+std::string ParameterText(const EffectBlock& b, const AugmentedModel& m) {
+  const auto names = ParameterNames(b.effect);
+  const auto p = ParametersInRecordingUnits(b, m);
+  const auto force = FrictionLevelsInInputUnits(b, m);
+  std::string s;
+  for (std::size_t i = 0; i < names.size() && i < p.size(); ++i) {
+    s += fmt::format("{}{} = {:.4g}", s.empty() ? "" : ", ", names[i], p[i]);
+    if (i < force.size()) s += fmt::format(" ({:.4g} in input units)", force[i]);
+  }
+  return s;
+}
+
+std::string AugmentedModel::Label() const {
+  if (blocks.empty()) return "none";
+  std::string s;
+  for (const auto& b : blocks) s += (s.empty() ? "" : "+") + b.Label();
+  return s;
+}
+
+AugmentedModel AugmentedModel::WithoutBlocks() const {
+  AugmentedModel m = *this;
+  m.blocks.clear();
+  return m;
+}
+
 bool AugmentedModel::simulate(const std::vector<double>& u, std::vector<double>* y) const {
   const std::size_t n = u.size();
-  std::vector<double> x = block.location == Location::kInput ? ApplyInputBlock(block, u) : u;
+  std::vector<double> x = u;
+  for (const auto& b : blocks)
+    if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
   for (auto& v : x) v = nominal.input(v);
   const auto& a = nominal.linear.a;
-  const auto& b = nominal.linear.b;
+  const auto& bb = nominal.linear.b;
   const long d = nominal.linear.delay;
-  double xmax = 0.0, bsum = 0.0;
+  const EffectBlock *friction = nullptr, *cubic = nullptr, *clamp = nullptr;
+  for (const auto& b : blocks) {
+    if (b.location != Location::kState) continue;
+    if (b.effect == Effect::kCoulombFriction) friction = &b;
+    if (b.effect == Effect::kCubicStiffness) cubic = &b;
+    if (b.effect == Effect::kStateSaturation) clamp = &b;
+  }
+  double xmax = 0.0, bsum = 0.0, zmax = 0.0;
   for (double v : x) xmax = std::max(xmax, std::abs(v));
-  for (double v : b) bsum += std::abs(v);
-  const double limit = 1e6 * (1.0 + xmax * bsum);
-  const bool state = block.location == Location::kState;
-  std::vector<double> z(n, 0.0);
+  for (double v : bb) bsum += std::abs(v);
+  for (double v : initial_state) zmax = std::max(zmax, std::abs(v));
+  const double limit = 1e6 * (1.0 + xmax * bsum + zmax);
+  // z before the first sample comes from the initial state (zero when empty).
+  const std::size_t pad = std::max<std::size_t>(a.size(), 2);
+  std::vector<double> zz(pad + n, 0.0);
+  for (std::size_t i = 0; i < initial_state.size() && i < pad; ++i) zz[pad - 1 - i] = initial_state[i];
   bool ok = true;
   for (std::size_t t = 0; t < n; ++t) {
+    const std::size_t k0 = pad + t;
     double acc = 0.0;
-    for (std::size_t i = 1; i <= a.size() && i <= t; ++i) acc -= a[i - 1] * z[t - i];
-    for (std::size_t j = 0; j < b.size(); ++j) {
+    for (std::size_t i = 1; i <= a.size(); ++i) acc -= a[i - 1] * zz[k0 - i];
+    for (std::size_t j = 0; j < bb.size(); ++j) {
       const long k = static_cast<long>(t) - d - static_cast<long>(j);
-      if (k >= 0) acc += b[j] * x[k];
+      if (k >= 0) acc += bb[j] * x[k];
     }
-    if (state) {
-      const double z1 = t >= 1 ? z[t - 1] : 0.0, z2 = t >= 2 ? z[t - 2] : 0.0;
-      switch (block.effect) {
-        case Effect::kCubicStiffness:
-          acc -= block.params[0] * z1 * z1 * z1;
-          break;
-        case Effect::kCoulombFriction:
-          acc -= block.params[0] * Sign(z1 - z2);
-          break;
-        case Effect::kStateSaturation:
-          acc = std::clamp(acc, block.params[0], block.params[1]);
-          break;
-        default:
-          break;
-      }
+    const double z1 = zz[k0 - 1];
+    if (cubic) acc -= cubic->params[0] * z1 * z1 * z1;
+    if (friction) {
+      const bool velocity = friction->state_variable == StateVariable::kVelocity;
+      const double v = FrictionStep(velocity ? acc : acc - z1, friction->params[0], friction->params[1]);
+      acc = velocity ? v : z1 + v;
     }
+    if (clamp) acc = std::clamp(acc, clamp->params[0], clamp->params[1]);
     if (!std::isfinite(acc) || std::abs(acc) > limit) {
       ok = false;
-      for (std::size_t s = t; s < n; ++s) z[s] = limit;
+      for (std::size_t s = k0; s < zz.size(); ++s) zz[s] = limit;
       break;
     }
-    z[t] = acc;
+    zz[k0] = acc;
   }
-  for (auto& v : z) {
-    v = nominal.output(v);
-    if (block.location == Location::kOutput) v = ApplyStaticBlock(block, v);
-    v += output_offset;
+  y->assign(zz.begin() + pad, zz.end());
+  for (auto& v : *y) {
+    v = nominal.output(v) + output_offset;
+    for (const auto& b : blocks)
+      if (b.location == Location::kOutput) v = ApplyStaticBlock(b, v);
   }
-  *y = std::move(z);
   return ok;
 }
 
@@ -285,37 +469,66 @@ std::vector<double> AugmentedModel::simulate(const std::vector<double>& u) const
 nlohmann::json AugmentedModel::to_json() const {
   nlohmann::json j = nominal.to_json();
   j["type"] = "augmented_hammerstein_wiener";
-  j["effect_block"] = block.to_json();
+  nlohmann::json bl = nlohmann::json::array();
+  for (const auto& b : blocks) bl.push_back(b.to_json());
+  j["effect_blocks"] = bl;
   j["output_offset"] = output_offset;
+  j["initial_state"] = initial_state;
   return j;
 }
 
 AugmentedModel AugmentedModel::from_json(const nlohmann::json& j) {
+  RequireKnownKeys(j,
+                   {"type", "name", "input_nonlinearity", "linear", "output_nonlinearity", "effect_blocks",
+                    "effect_block", "output_offset", "initial_state"},
+                   "model JSON");
+  if (j.contains("linear")) RequireKnownKeys(j.at("linear"), {"a", "b", "delay"}, "model JSON, linear");
+  for (const char* k : {"input_nonlinearity", "output_nonlinearity"})
+    if (j.contains(k)) CheckStaticMapKeys(j.at(k), fmt::format("model JSON, {}", k));
+  const std::string type = j.value("type", "hammerstein_wiener");
+  if (type != "hammerstein_wiener" && type != "augmented_hammerstein_wiener")
+    throw InputError(fmt::format("model JSON: type '{}' unknown; expected hammerstein_wiener or "
+                                 "augmented_hammerstein_wiener", type));
   AugmentedModel m;
-  nlohmann::json base = j;
+  nlohmann::json base = j;  // the plain part goes to the project's reader
+  for (const char* k : {"effect_blocks", "effect_block", "output_offset", "initial_state"}) base.erase(k);
   base["type"] = "hammerstein_wiener";
-  m.nominal = HwModel::from_json(base, {"output_offset", "effect_block"});  // the keys an augmented model adds
-  if (j.contains("output_offset") && j["output_offset"].is_number()) m.output_offset = j["output_offset"].get<double>();
-  if (j.contains("effect_block")) {
-    try {
-      const auto& e = j.at("effect_block");
-      m.block.effect = ParseEffect(e.at("effect").get<std::string>());
-      m.block.location = ParseLocation(e.value("location", "input"));
-      const auto names = ParameterNames(m.block.effect);
-      for (const auto& n : names) {
-        const auto& v = e.at("parameters").at(n);
-        if (v.is_string())
-          m.block.params.push_back(v.get<std::string>() == "-inf" ? -HUGE_VAL : HUGE_VAL);
-        else
-          m.block.params.push_back(v.get<double>());
-      }
-    } catch (const nlohmann::json::exception& ex) {
-      throw InputError(fmt::format("augmented model JSON, effect_block: {}", ex.what()));
-    }
-    std::string err;
-    if (!m.block.IsValid(&err)) throw InputError("augmented model JSON: " + err);
+  m.nominal = HwModel::from_json(base);
+  try {
+    if (j.contains("output_offset")) m.output_offset = j.at("output_offset").get<double>();
+    if (j.contains("initial_state")) m.initial_state = j.at("initial_state").get<std::vector<double>>();
+  } catch (const nlohmann::json::exception& ex) {
+    throw InputError(fmt::format("model JSON, output_offset / initial_state: {}", ex.what()));
   }
+  if (m.initial_state.size() > m.nominal.linear.a.size())
+    throw InputError(fmt::format("model JSON: initial_state has {} values but the linear block has {} a coefficients",
+                                 m.initial_state.size(), m.nominal.linear.a.size()));
+  if (j.contains("effect_block")) m.blocks.push_back(EffectBlock::from_json(j.at("effect_block")));
+  if (j.contains("effect_blocks")) {
+    if (!j.at("effect_blocks").is_array()) throw InputError("model JSON: effect_blocks must be an array");
+    for (const auto& b : j.at("effect_blocks")) m.blocks.push_back(EffectBlock::from_json(b));
+  }
+  m.blocks.erase(std::remove_if(m.blocks.begin(), m.blocks.end(),
+                                [](const EffectBlock& b) { return b.effect == Effect::kNone; }),
+                 m.blocks.end());
+  if (m.blocks.size() > 2) throw InputError("model JSON: at most two effect blocks");
   return m;
+}
+
+AugmentedModel AugmentedModel::Load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open model file", path));
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
+  }
+  try {
+    return from_json(j);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()));
+  }
 }
 
 }  // namespace hw::diagnose

@@ -25,33 +25,35 @@ Vec LogSpace(double lo, double hi, int n) {
 
 // Which model numbers the optimiser may move, and how they map to a flat vector.
 struct Packing {
-  int na = 0, nb = 0, nin = 0, nout = 0;
+  int na = 0, nb = 0, nin = 0, nout = 0, ninit = 0;
   bool offset = false;
-  std::vector<int> effect;  // indices into block.params
+  std::vector<std::pair<int, int>> effect;  // (block, parameter) pairs
 
-  static Packing For(const AugmentedModel& m, bool refit_maps, bool with_effect_smooth, bool with_offset) {
+  static Packing For(const AugmentedModel& m, const RefitOptions& o) {
     Packing p;
-    p.offset = with_offset;
+    p.offset = o.fit_output_offset;
     p.na = static_cast<int>(m.nominal.linear.a.size());
     p.nb = static_cast<int>(m.nominal.linear.b.size());
-    if (refit_maps && m.nominal.input.kind == StaticMap::Kind::kPolynomial)
+    if (o.refit_maps && m.nominal.input.kind == StaticMap::Kind::kPolynomial)
       p.nin = static_cast<int>(m.nominal.input.coefficients.size()) - 1;
-    if (refit_maps && m.nominal.output.kind == StaticMap::Kind::kPolynomial)
+    if (o.refit_maps && m.nominal.output.kind == StaticMap::Kind::kPolynomial)
       p.nout = static_cast<int>(m.nominal.output.coefficients.size()) - 1;
-    if (with_effect_smooth)
-      for (std::size_t i = 0; i < m.block.params.size(); ++i)
-        if (ParameterIsSmooth(m.block.effect, static_cast<int>(i)) && std::isfinite(m.block.params[i]))
-          p.effect.push_back(static_cast<int>(i));
+    if (o.estimate_initial_state) p.ninit = p.na;
+    for (std::size_t b = 0; b < m.blocks.size(); ++b)
+      for (std::size_t i = 0; i < m.blocks[b].params.size(); ++i)
+        if (ParameterIsSmooth(m.blocks[b].effect, static_cast<int>(i)) && std::isfinite(m.blocks[b].params[i]))
+          p.effect.emplace_back(static_cast<int>(b), static_cast<int>(i));
     return p;
   }
   Vec Pack(const AugmentedModel& m) const {
     Vec v;
-    for (double a : m.nominal.linear.a) v.push_back(a);
-    for (double b : m.nominal.linear.b) v.push_back(b);
+    for (int i = 0; i < na; ++i) v.push_back(m.nominal.linear.a[i]);
+    for (int i = 0; i < nb; ++i) v.push_back(m.nominal.linear.b[i]);
     for (int i = 0; i < nin; ++i) v.push_back(m.nominal.input.coefficients[i + 1]);
     for (int i = 0; i < nout; ++i) v.push_back(m.nominal.output.coefficients[i + 1]);
-    for (int i : effect) v.push_back(m.block.params[i]);
+    for (const auto& [b, i] : effect) v.push_back(m.blocks[b].params[i]);
     if (offset) v.push_back(m.output_offset);
+    for (int i = 0; i < ninit; ++i) v.push_back(i < static_cast<int>(m.initial_state.size()) ? m.initial_state[i] : 0.0);
     return v;
   }
   void Unpack(const Vec& v, AugmentedModel* m) const {
@@ -60,27 +62,10 @@ struct Packing {
     for (int i = 0; i < nb; ++i) m->nominal.linear.b[i] = v[k++];
     for (int i = 0; i < nin; ++i) m->nominal.input.coefficients[i + 1] = v[k++];
     for (int i = 0; i < nout; ++i) m->nominal.output.coefficients[i + 1] = v[k++];
-    for (int i : effect) m->block.params[i] = v[k++];
+    for (const auto& [b, i] : effect) m->blocks[b].params[i] = v[k++];
     if (offset) m->output_offset = v[k++];
-    Legalise(&m->block);
-  }
-  // Keeps the optimiser inside each block's domain (widths >= 0, lower < upper).
-  static void Legalise(EffectBlock* b) {
-    switch (b->effect) {
-      case Effect::kBacklash:
-      case Effect::kDeadzone:
-        b->params[0] = std::abs(b->params[0]);
-        break;
-      case Effect::kRateLimit:
-        b->params[0] = std::max(std::abs(b->params[0]), 1e-12);
-        break;
-      case Effect::kSaturation:
-      case Effect::kStateSaturation:
-        if (b->params[0] > b->params[1]) std::swap(b->params[0], b->params[1]);
-        break;
-      default:
-        break;
-    }
+    if (ninit > 0) m->initial_state.assign(v.begin() + k, v.begin() + k + ninit), k += ninit;
+    for (auto& b : m->blocks) ClampToPhysicalRange(&b);
   }
 };
 
@@ -88,39 +73,150 @@ void Residual(const AugmentedModel& m, const Segment& s, Vec* r) {
   Vec yhat;
   m.simulate(*s.u, &yhat);
   const auto& y = *s.y;
-  r->resize(y.size() - std::min(s.skip, y.size()));
-  for (std::size_t t = s.skip; t < y.size(); ++t) (*r)[t - s.skip] = y[t] - yhat[t];
+  const std::size_t end = s.End();
+  r->resize(s.Count());
+  for (std::size_t t = s.skip; t < end; ++t) (*r)[t - s.skip] = y[t] - yhat[t];
 }
 
-// Exact output-error numerator for fixed poles: y ~ sum_j b_j f_{t-d-j}, f = x / A(q).
-bool SolveNumerator(AugmentedModel* m, const Segment& s, bool with_offset) {
-  if (m->nominal.output.kind != StaticMap::Kind::kIdentity || m->block.location != Location::kInput) return false;
-  Vec x = ApplyInputBlock(m->block, *s.u);
-  for (auto& v : x) v = m->nominal.input(v);
-  LinearBlock filt{m->nominal.linear.a, {1.0}, 0};
-  const Vec f = filt.simulate(x);
-  const int nb = static_cast<int>(m->nominal.linear.b.size());
-  const long d = m->nominal.linear.delay;
-  const std::size_t n = s.y->size();
-  if (n <= s.skip + nb) return false;
-  Eigen::MatrixXd phi(n - s.skip, nb + (with_offset ? 1 : 0));
-  Eigen::VectorXd yy(n - s.skip);
-  for (std::size_t t = s.skip; t < n; ++t) {
-    for (int j = 0; j < nb; ++j) {
-      const long k = static_cast<long>(t) - d - j;
-      phi(t - s.skip, j) = k >= 0 ? f[k] : 0.0;
-    }
-    if (with_offset) phi(t - s.skip, nb) = 1.0;
-    yy(t - s.skip) = (*s.y)[t];
+// Whether a polynomial map is monotone on [lo, hi] (its derivative keeps one sign on a fine grid).
+bool MonotoneOn(const StaticMap& map, double lo, double hi) {
+  if (map.kind != StaticMap::Kind::kPolynomial || !(hi > lo)) return true;
+  int sign = 0;
+  for (int i = 0; i <= 64; ++i) {
+    const double v = lo + (hi - lo) * i / 64.0;
+    double d = 0.0;
+    for (std::size_t k = 0; k < map.coefficients.size(); ++k) d += (k + 1) * map.coefficients[k] * std::pow(v, k);
+    const int sd = d > 0 ? 1 : (d < 0 ? -1 : 0);
+    if (sd != 0 && sign != 0 && sd != sign) return false;
+    if (sd != 0) sign = sd;
   }
-  const Eigen::VectorXd b = phi.colPivHouseholderQr().solve(yy);
-  if (!b.allFinite()) return false;
-  for (int j = 0; j < nb; ++j) m->nominal.linear.b[j] = b(j);
-  if (with_offset) m->output_offset = b(nb);
   return true;
 }
 
-// Grid of effect parameters, scaled to the recording and to the nominal simulation.
+Vec LmScale(const Vec& p0) {
+  Vec scale(p0.size());
+  for (std::size_t i = 0; i < p0.size(); ++i) scale[i] = std::max(std::abs(p0[i]), 1e-3);
+  return scale;
+}
+
+// The linear block's output z of m for input u (no output map, offset or output blocks).
+Vec InnerState(const AugmentedModel& m, const Vec& u) {
+  AugmentedModel inner = m;
+  inner.nominal.output = StaticMap{};
+  inner.output_offset = 0.0;
+  inner.blocks.erase(std::remove_if(inner.blocks.begin(), inner.blocks.end(),
+                                    [](const EffectBlock& b) { return b.location == Location::kOutput; }),
+                     inner.blocks.end());
+  return inner.simulate(u);
+}
+
+// A weak prior on the initial state: an initial z a hundred ranges of z away from z's mean costs as much
+// as one typical sample error. Legitimate initial states (within a few ranges) cost next to nothing; it
+// only stops ill-conditioned estimates (slow, nearly equal poles, warm-up samples excluded) from
+// running off to values no recording could produce.
+struct InitialStatePrior {
+  double centre = 0.0, weight = 0.0;
+  InitialStatePrior(const AugmentedModel& m, const Segment& s, int ninit) {
+    if (ninit == 0 || s.Count() == 0) return;
+    const Vec zall = InnerState(m, *s.u);
+    const Vec z(zall.begin() + s.skip, zall.begin() + s.End());  // where the data constrain it
+    const auto [lo, hi] = std::minmax_element(z.begin(), z.end());
+    Vec r;
+    Residual(m, s, &r);
+    double e2 = 0.0;
+    for (double v : r) e2 += v * v;
+    const double rms = std::sqrt(e2 / r.size());
+    centre = 0.5 * (*lo + *hi);
+    weight = std::isfinite(rms) ? std::max(rms, 1e-12) / (100.0 * std::max(*hi - *lo, 1e-12)) : 0.0;
+  }
+  void Append(const AugmentedModel& m, int ninit, Vec* r) const {
+    for (int i = 0; i < ninit; ++i)
+      r->push_back(weight * ((i < static_cast<int>(m.initial_state.size()) ? m.initial_state[i] : 0.0) - centre));
+  }
+};
+
+// LM over the numbers chosen by `pk`. A step that would make a monotone static map non-monotone over
+// the data is refused (a bad but finite cost): actuator and sensor characteristics are monotone, and a
+// map that folds back could mimic a missing effect instead of letting the diagnosis name it.
+void Lm(AugmentedModel* m, const Packing& pk, const Segment& s, const LmOptions& lo) {
+  Vec p0 = pk.Pack(*m);
+  if (p0.empty()) return;
+  AugmentedModel work = *m;
+  const bool guard = (pk.nin > 0 || pk.nout > 0) && MapsMonotone(*m, *s.u);
+  const InitialStatePrior prior(*m, s, pk.ninit);
+  double refused = 1.0;
+  for (std::size_t t = s.skip; t < s.End(); ++t) refused = std::max(refused, 1e3 * std::abs((*s.y)[t]));
+  LmSummary sum;
+  const Vec p = LevenbergMarquardt(
+      [&](const Vec& q, Vec* r) {
+        pk.Unpack(q, &work);
+        if (guard && !MapsMonotone(work, *s.u)) {
+          r->assign(s.Count() + pk.ninit, refused);
+          return;
+        }
+        Residual(work, s, r);
+        prior.Append(work, pk.ninit, r);
+      },
+      p0, LmScale(p0), lo, &sum);
+  pk.Unpack(p, m);
+  m->nominal.linear.a = StabilisedDenominator(m->nominal.linear.a);
+}
+
+bool HasStateBlock(const AugmentedModel& m) {
+  for (const auto& b : m.blocks)
+    if (b.location == Location::kState) return true;
+  return false;
+}
+
+// Exact least squares, for fixed poles, of the numerator, the offset and the initial state:
+// y ~ sum_j b_j f_{t-d-j} + c + sum_i s_i h_i(t), with f = x / A(q) and h_i the free response of 1/A(q)
+// to z_{-i} = 1. Only for models that are linear in these numbers (input blocks, identity output map).
+bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  if (m->nominal.output.kind != StaticMap::Kind::kIdentity || HasStateBlock(*m)) return false;
+  for (const auto& b : m->blocks)
+    if (b.location == Location::kOutput) return false;
+  Vec x = *s.u;
+  for (const auto& b : m->blocks) x = ApplyInputBlock(b, x);
+  for (auto& v : x) v = m->nominal.input(v);
+  const auto& a = m->nominal.linear.a;
+  const Vec f = LinearBlock{a, {1.0}, 0}.simulate(x);
+  const int nb = static_cast<int>(m->nominal.linear.b.size());
+  const int ninit = o.estimate_initial_state ? static_cast<int>(a.size()) : 0;
+  const long d = m->nominal.linear.delay;
+  const std::size_t n = s.End();
+  if (s.Count() <= static_cast<std::size_t>(nb + ninit + 1)) return false;
+  std::vector<Vec> h(ninit);
+  for (int i = 0; i < ninit; ++i) {
+    AugmentedModel free;
+    free.nominal.linear = {a, {0.0}, 0};
+    free.initial_state.assign(ninit, 0.0);
+    free.initial_state[i] = 1.0;
+    free.simulate(Vec(n, 0.0), &h[i]);
+  }
+  const int cols = nb + (o.fit_output_offset ? 1 : 0) + ninit;
+  Eigen::MatrixXd phi(s.Count(), cols);
+  Eigen::VectorXd yy(s.Count());
+  for (std::size_t t = s.skip; t < n; ++t) {
+    const std::size_t r = t - s.skip;
+    int c = 0;
+    for (int j = 0; j < nb; ++j) {
+      const long k = static_cast<long>(t) - d - j;
+      phi(r, c++) = k >= 0 ? f[k] : 0.0;
+    }
+    if (o.fit_output_offset) phi(r, c++) = 1.0;
+    for (int i = 0; i < ninit; ++i) phi(r, c++) = h[i][t];
+    yy(r) = (*s.y)[t];
+  }
+  const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
+  if (!th.allFinite()) return false;
+  int c = 0;
+  for (int j = 0; j < nb; ++j) m->nominal.linear.b[j] = th(c++);
+  if (o.fit_output_offset) m->output_offset = th(c++);
+  if (ninit > 0) m->initial_state.assign(th.data() + c, th.data() + c + ninit);
+  return true;
+}
+
+// Grid of the new block's parameters, scaled to the recording and to the current simulation.
 std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, const Vec& zhat, const HwModel& nominal) {
   std::vector<Vec> g;
   const Vec& v = l == Location::kInput ? u : (l == Location::kOutput ? y : zhat);
@@ -132,9 +228,15 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
     case Effect::kBacklash:
       for (double w : LogSpace(1e-3 * range, 0.3 * range, 36)) g.push_back({w});
       break;
-    case Effect::kDeadzone:
+    case Effect::kStiction:
+      for (double fs : LogSpace(1e-3 * range, 0.3 * range, 30))
+        for (double r : {0.0, 0.3, 0.6, 0.9}) g.push_back({fs, r * fs});
+      break;
+    case Effect::kDeadzone: {
+      // Around the signal's own zero: deadzones act on the signal's magnitude.
       for (double d : LogSpace(2e-3 * vmax, 0.6 * vmax, 36)) g.push_back({d});
       break;
+    }
     case Effect::kSaturation:
     case Effect::kStateSaturation: {
       const Vec qs = {0.002, 0.005, 0.01, 0.02, 0.04, 0.07, 0.1, 0.15, 0.2, 0.3};
@@ -170,10 +272,7 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
       const double su = Rms(u);
       for (double qb : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9}) {
         const double beta = Quantile(au, qb);
-        for (double h : LogSpace(3e-3 * su, 0.3 * su, 12)) {
-          g.push_back({beta, h});
-          g.push_back({beta, -h});
-        }
+        for (double h : LogSpace(3e-3 * su, 0.3 * su, 12)) g.push_back({beta, h});
       }
       break;
     }
@@ -182,13 +281,15 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
       // Forcing scale: the numerator's contribution per step.
       Vec x(u.size());
       for (std::size_t t = 0; t < u.size(); ++t) x[t] = nominal.input(u[t]);
-      LinearBlock num{{}, nominal.linear.b, nominal.linear.delay};
-      const double s = std::max(Rms(num.simulate(x)), 1e-12);
+      const double s = std::max(Rms(LinearBlock{{}, nominal.linear.b, nominal.linear.delay}.simulate(x)), 1e-12);
       const double zr = std::max(Rms(zhat), 1e-12);
       for (double c : LogSpace(1e-4, 10.0, 36)) {
-        const double val = e == Effect::kCubicStiffness ? c * s / (zr * zr * zr) : c * s;
-        g.push_back({val});
-        g.push_back({-val});
+        if (e == Effect::kCubicStiffness) {
+          g.push_back({c * s / (zr * zr * zr)});
+          g.push_back({-c * s / (zr * zr * zr)});  // softening spring
+        } else {
+          g.push_back({c * s, c * s});
+        }
       }
       break;
     }
@@ -212,49 +313,34 @@ Vec LocalValues(Effect e, double v) {
   return out;
 }
 
-RefitResult Polish(AugmentedModel m, const Segment& s, const RefitOptions& o) {
-  // LM on the linear block, maps and smooth effect parameters.
-  auto lm = [&](AugmentedModel* mm, bool effect_smooth) {
-    const Packing pk = Packing::For(*mm, o.refit_maps, effect_smooth, o.fit_output_offset);
-    Vec p0 = pk.Pack(*mm);
-    Vec scale(p0.size(), 1e-3);
-    for (std::size_t i = 0; i < p0.size(); ++i) scale[i] = std::max(std::abs(p0[i]), 1e-3);
-    LmSummary sum;
-    AugmentedModel work = *mm;
-    const Vec p = LevenbergMarquardt(
-        [&](const Vec& q, Vec* r) {
-          pk.Unpack(q, &work);
-          Residual(work, s, r);
-        },
-        p0, scale, o.lm, &sum);
-    pk.Unpack(p, mm);
-    mm->nominal.linear.a = StabilisedDenominator(mm->nominal.linear.a);
-  };
-  lm(&m, true);
-  bool has_search = false;
-  for (std::size_t i = 0; i < m.block.params.size(); ++i)
-    has_search = has_search || !ParameterIsSmooth(m.block.effect, static_cast<int>(i));
-  if (has_search) {
-    for (std::size_t i = 0; i < m.block.params.size(); ++i) {
-      if (ParameterIsSmooth(m.block.effect, static_cast<int>(i))) continue;
-      double best = SumSquaredError(m, s), best_v = m.block.params[i];
-      for (double v : LocalValues(m.block.effect, m.block.params[i])) {
-        AugmentedModel t = m;
-        t.block.params[i] = v;
+// Local search of every search-only parameter, then LM again.
+void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  bool any = false;
+  for (std::size_t b = 0; b < m->blocks.size(); ++b)
+    for (std::size_t i = 0; i < m->blocks[b].params.size(); ++i) {
+      if (ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i))) continue;
+      any = true;
+      double best = SumSquaredError(*m, s);
+      AugmentedModel best_m = *m;
+      for (double v : LocalValues(m->blocks[b].effect, m->blocks[b].params[i])) {
+        AugmentedModel t = *m;
+        t.blocks[b].params[i] = v;
         std::string err;
-        if (!t.block.IsValid(&err)) continue;
-        SolveNumerator(&t, s, o.fit_output_offset);
+        if (!t.blocks[b].IsValid(&err)) continue;
+        SolveNumerator(&t, s, o);
         const double c = SumSquaredError(t, s);
-        if (c < best) best = c, best_v = v;
+        if (c < best) best = c, best_m = t;
       }
-      m.block.params[i] = best_v;
+      *m = best_m;
     }
-    lm(&m, true);
-  }
+  if (any) Lm(m, Packing::For(*m, o), s, o.lm);
+}
+
+RefitResult Finish(const AugmentedModel& m, const Segment& s) {
   RefitResult r;
   r.model = m;
   r.sse = SumSquaredError(m, s);
-  for (double p : m.block.params) r.extra_parameters += std::isfinite(p) ? 1 : 0;
+  r.extra_parameters = EffectParameterCount(m);
   return r;
 }
 
@@ -273,28 +359,6 @@ Vec PolyFromRoots(const std::vector<std::complex<double>>& roots) {
   return a;
 }
 
-// Least squares ARX on (x, y) (optionally both prefiltered by 1/A): returns [a; b].
-bool Arx(const Vec& x, const Vec& y, int na, int nb, int d, std::size_t skip, Vec* a, Vec* b) {
-  const std::size_t n = y.size();
-  const std::size_t start = std::max<std::size_t>(skip, std::max(na, d + nb - 1));
-  if (n <= start + na + nb) return false;
-  Eigen::MatrixXd phi(n - start, na + nb);
-  Eigen::VectorXd yy(n - start);
-  for (std::size_t t = start; t < n; ++t) {
-    for (int i = 1; i <= na; ++i) phi(t - start, i - 1) = -y[t - i];
-    for (int j = 0; j < nb; ++j) {
-      const long k = static_cast<long>(t) - d - j;
-      phi(t - start, na + j) = k >= 0 ? x[k] : 0.0;
-    }
-    yy(t - start) = y[t];
-  }
-  const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
-  if (!th.allFinite()) return false;
-  a->assign(th.data(), th.data() + na);
-  b->assign(th.data() + na, th.data() + na + nb);
-  return true;
-}
-
 }  // namespace
 
 bool LmOptions::IsValid(std::string* error) const {
@@ -311,6 +375,23 @@ bool RefitOptions::IsValid(std::string* error) const {
     return false;
   }
   return lm.IsValid(error);
+}
+
+bool MapsMonotone(const AugmentedModel& m, const Vec& u) {
+  if (u.empty()) return true;
+  const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
+  if (!MonotoneOn(m.nominal.input, *ulo, *uhi)) return false;
+  if (m.nominal.output.kind != StaticMap::Kind::kPolynomial) return true;
+  const Vec z = InnerState(m, u);  // what the output map sees
+  const auto [zlo, zhi] = std::minmax_element(z.begin(), z.end());
+  return MonotoneOn(m.nominal.output, *zlo, *zhi);
+}
+
+int EffectParameterCount(const AugmentedModel& m) {
+  int k = 0;
+  for (const auto& b : m.blocks)
+    for (double p : b.params) k += std::isfinite(p) ? 1 : 0;
+  return k;
 }
 
 Vec LevenbergMarquardt(const std::function<void(const Vec&, Vec*)>& residual, Vec p, const Vec& scale,
@@ -396,136 +477,103 @@ Vec StabilisedDenominator(const Vec& a) {
   return changed ? PolyFromRoots(roots) : a;
 }
 
-bool NominalSpec::IsValid(std::string* error) const {
-  if (na < 0 || nb < 1 || delay < 0 || input_degree < 1 || output_degree < 1 || na > 20 || nb > 40 ||
-      input_degree > 9 || output_degree > 9) {
-    if (error) *error = "nominal structure needs 0 <= NA <= 20, 1 <= NB <= 40, DELAY >= 0, 1 <= degrees <= 9";
-    return false;
+bool FitArx(const Vec& x, const Vec& y, int na, int nb, int d, std::size_t skip, std::size_t end, bool with_constant,
+            Vec* a, Vec* b, double* constant) {
+  const std::size_t n = end == 0 || end > y.size() ? y.size() : end;
+  const std::size_t start = std::max<std::size_t>(skip, std::max(na, d + nb - 1));
+  const int cols = na + nb + (with_constant ? 1 : 0);
+  if (n <= start + cols) return false;
+  Eigen::MatrixXd phi(n - start, cols);
+  Eigen::VectorXd yy(n - start);
+  for (std::size_t t = start; t < n; ++t) {
+    for (int i = 1; i <= na; ++i) phi(t - start, i - 1) = -y[t - i];
+    for (int j = 0; j < nb; ++j) {
+      const long k = static_cast<long>(t) - d - j;
+      phi(t - start, na + j) = k >= 0 ? x[k] : 0.0;
+    }
+    if (with_constant) phi(t - start, na + nb) = 1.0;
+    yy(t - start) = y[t];
   }
+  const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
+  if (!th.allFinite()) return false;
+  a->assign(th.data(), th.data() + na);
+  b->assign(th.data() + na, th.data() + na + nb);
+  if (constant) *constant = with_constant ? th(na + nb) : 0.0;
   return true;
 }
 
-NominalSpec NominalSpec::Parse(const std::string& text) {
-  const auto colon = text.find(':');
-  const std::string kind = text.substr(0, colon);
-  std::vector<int> nums;
-  if (colon != std::string::npos) {
-    std::string rest = text.substr(colon + 1);
-    std::size_t pos = 0;
-    while (pos <= rest.size()) {
-      const auto comma = rest.find(',', pos);
-      const std::string tok = rest.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-      try {
-        std::size_t used = 0;
-        nums.push_back(std::stoi(tok, &used));
-        if (used != tok.size()) throw std::invalid_argument(tok);
-      } catch (const std::exception&) {
-        throw InputError(fmt::format("--fit '{}': '{}' is not an integer; expected linear:NA,NB[,DELAY] or "
-                                     "hw:NA,NB,PIN,POUT[,DELAY]", text, tok));
-      }
-      if (comma == std::string::npos) break;
-      pos = comma + 1;
-    }
-  }
-  NominalSpec s;
-  if (kind == "linear" && (nums.size() == 2 || nums.size() == 3)) {
-    s.na = nums[0];
-    s.nb = nums[1];
-    if (nums.size() == 3) s.delay = nums[2];
-  } else if (kind == "hw" && (nums.size() == 4 || nums.size() == 5)) {
-    s.na = nums[0];
-    s.nb = nums[1];
-    s.input_degree = nums[2];
-    s.output_degree = nums[3];
-    if (nums.size() == 5) s.delay = nums[4];
-  } else {
-    throw InputError(fmt::format("--fit '{}' not understood; expected linear:NA,NB[,DELAY] (e.g. linear:2,2) or "
-                                 "hw:NA,NB,PIN,POUT[,DELAY] (e.g. hw:2,2,3,1)", text));
-  }
-  std::string err;
-  if (!s.IsValid(&err)) throw InputError(fmt::format("--fit '{}': {}", text, err));
-  return s;
+void EstimateInitialState(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  if (!o.estimate_initial_state || m->nominal.linear.a.empty()) return;
+  Packing pk;
+  pk.ninit = static_cast<int>(m->nominal.linear.a.size());
+  LmOptions lo = o.lm;
+  lo.max_iterations = std::min(lo.max_iterations, 30);
+  Lm(m, pk, s, lo);
 }
 
-HwModel FitNominal(const NominalSpec& spec, const Segment& data) {
-  const Vec& u = *data.u;
-  const Vec& y = *data.y;
-  Vec a, b;
-  if (!Arx(u, y, spec.na, spec.nb, spec.delay, data.skip, &a, &b)) {
-    a.assign(spec.na, 0.0);
-    b.assign(spec.nb, 0.0);
-  }
-  a = StabilisedDenominator(a);
-  // Steiglitz–McBride: prefilter by the current 1/A and re-solve; converges towards the OE fit.
-  HwModel m;
-  m.linear = {a, b, spec.delay};
-  double best = SumSquaredError(AugmentedModel{m, {}}, data);
-  for (int it = 0; it < 6 && spec.na > 0; ++it) {
-    LinearBlock filt{a, {1.0}, 0};
-    const Vec uf = filt.simulate(u), yf = filt.simulate(y);
-    Vec a2, b2;
-    if (!Arx(uf, yf, spec.na, spec.nb, spec.delay, data.skip, &a2, &b2)) break;
-    a2 = StabilisedDenominator(a2);
-    HwModel t = m;
-    t.linear = {a2, b2, spec.delay};
-    const double c = SumSquaredError(AugmentedModel{t, {}}, data);
-    a = a2;
-    if (c < best) best = c, m = t;
-  }
-  if (spec.input_degree > 1) {
-    Vec c(spec.input_degree, 0.0);
-    c[0] = 1.0;
-    m.input = StaticMap::Polynomial(c);
-  }
-  if (spec.output_degree > 1) {
-    Vec c(spec.output_degree, 0.0);
-    c[0] = 1.0;
-    m.output = StaticMap::Polynomial(c);
-  }
-  m.name = spec.input_degree > 1 || spec.output_degree > 1
-               ? fmt::format("hw:{},{},{},{},{}", spec.na, spec.nb, spec.input_degree, spec.output_degree, spec.delay)
-               : fmt::format("linear:{},{},{}", spec.na, spec.nb, spec.delay);
-  RefitOptions o;
-  o.lm.max_iterations = 80;
-  o.fit_output_offset = false;  // HwModel has no offset; the diagnosis estimates one with every refit
-  return RefitNominal(m, data, o).model.nominal;
+RefitResult RefitModel(const AugmentedModel& model, const Segment& s, const RefitOptions& o) {
+  AugmentedModel m = model;
+  if (o.estimate_initial_state) m.initial_state.resize(m.nominal.linear.a.size(), 0.0);
+  // Least squares is a good start for models linear in b, offset and initial state; keep it only if
+  // it does not start worse than the model as given.
+  AugmentedModel solved = m;
+  if (SolveNumerator(&solved, s, o) && SumSquaredError(solved, s) < SumSquaredError(m, s)) m = solved;
+  Lm(&m, Packing::For(m, o), s, o.lm);
+  SearchOnlyParameters(&m, s, o);
+  return Finish(m, s);
 }
 
-RefitResult RefitNominal(const HwModel& nominal, const Segment& data, const RefitOptions& options) {
-  AugmentedModel m{nominal, {}};
-  return Polish(m, data, options);
-}
-
-RefitResult RefitWithEffect(const HwModel& nominal, Effect effect, Location location, const Segment& data,
-                            const RefitOptions& options, double output_offset) {
-  if (effect == Effect::kNone) return RefitNominal(nominal, data, options);
-  const Vec& u = *data.u;
-  Vec zhat = LinearBlock(nominal.linear).simulate([&] {
-    Vec x(u.size());
-    for (std::size_t t = 0; t < u.size(); ++t) x[t] = nominal.input(u[t]);
-    return x;
-  }());
-  const auto grid = EffectGrid(effect, location, u, *data.y, zhat, nominal);
+RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location location, StateVariable sv, const Segment& s,
+                     const RefitOptions& o, LimitSides sides) {
+  if (effect == Effect::kNone || base.blocks.size() >= 2) return RefitModel(base, s, o);
+  const Vec& u = *s.u;
+  // The signal the block acts on, from the current model: the state for state blocks.
+  const Vec zhat = InnerState(base, u);
+  Vec input = u;  // a second input block acts after the first one
+  for (const auto& b : base.blocks)
+    if (b.location == Location::kInput) input = ApplyInputBlock(b, input);
+  const Vec yhat = base.simulate(u);
+  const auto grid = EffectGrid(effect, location, location == Location::kInput ? input : u,
+                               location == Location::kOutput ? yhat : *s.y, zhat, base.nominal);
   std::vector<std::pair<double, AugmentedModel>> scored;
+  auto wanted = [&](const Vec& p) {
+    if (p.size() != 2 || (effect != Effect::kSaturation && effect != Effect::kStateSaturation)) return true;
+    const bool lo = std::isfinite(p[0]), hi = std::isfinite(p[1]);
+    switch (sides) {
+      case LimitSides::kUpper:
+        return hi && !lo;
+      case LimitSides::kLower:
+        return lo && !hi;
+      case LimitSides::kBoth:
+        return lo && hi;
+      default:
+        return true;
+    }
+  };
   for (const auto& p : grid) {
-    AugmentedModel m{nominal, {effect, location, p}, options.fit_output_offset ? output_offset : 0.0};
+    if (!wanted(p)) continue;
+    AugmentedModel m = base;
+    EffectBlock b{effect, location, p, sv};
     std::string err;
-    if (!m.block.IsValid(&err)) continue;
-    SolveNumerator(&m, data, options.fit_output_offset);
-    const double c = SumSquaredError(m, data);
+    if (!b.IsValid(&err)) continue;
+    m.blocks.push_back(b);
+    if (o.estimate_initial_state) m.initial_state.resize(m.nominal.linear.a.size(), 0.0);
+    SolveNumerator(&m, s, o);
+    const double c = SumSquaredError(m, s);
     if (std::isfinite(c)) scored.emplace_back(c, m);
   }
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   RefitResult best;
   best.sse = std::numeric_limits<double>::infinity();
-  const int keep = std::min<int>(options.keep_grid_points, static_cast<int>(scored.size()));
+  const int keep = std::min<int>(o.keep_grid_points, static_cast<int>(scored.size()));
   for (int i = 0; i < keep; ++i) {
-    RefitResult r = Polish(scored[i].second, data, options);
+    AugmentedModel m = scored[i].second;
+    Lm(&m, Packing::For(m, o), s, o.lm);
+    SearchOnlyParameters(&m, s, o);
+    RefitResult r = Finish(m, s);
     if (r.sse < best.sse) best = r;
   }
-  if (!std::isfinite(best.sse)) {  // no admissible grid point: report the block switched off
-    best = RefitNominal(nominal, data, options);
-  }
+  if (!std::isfinite(best.sse)) best = RefitModel(base, s, o);  // no admissible grid point
   return best;
 }
 

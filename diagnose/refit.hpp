@@ -1,14 +1,14 @@
 #pragma once
-// Estimation for the diagnosis: output-error fitting of the nominal model and joint refit of an
-// effect block with the model's own parameters.
+// Estimation for the diagnosis: joint refit of effect blocks with the model's own parameters.
 //
 // Method (why): the effect parameters enter the simulation non-smoothly and the cost has local
-// minima, so each candidate is first searched on a grid scaled to the recording (for input blocks the
-// linear numerator is re-solved by least squares at every grid point, with the denominator held, which
-// is exact output-error for fixed poles); the best grid points are then refined jointly with the
-// linear block (and polynomial maps) by Levenberg–Marquardt on the simulation error, with
-// forward-difference Jacobians. Search-only parameters (integer delay, quantisation step, relay
-// threshold) are refined by a finer local grid instead.
+// minima, so each candidate block is first searched on a grid scaled to the recording (for input
+// blocks the linear numerator, the output offset and the initial state are re-solved by least squares
+// at every grid point with the poles held, which is exact output error for fixed poles); the best grid
+// points are then refined jointly with the linear block (and polynomial maps, offset, initial state) by
+// Levenberg–Marquardt on the simulation error, with forward-difference Jacobians. Search-only
+// parameters (integer delay, quantisation step, relay threshold) are refined by a finer local grid.
+// Every step keeps the block parameters in their physical range (ClampToPhysicalRange).
 #include <functional>
 #include <string>
 #include <vector>
@@ -36,50 +36,61 @@ std::vector<double> LevenbergMarquardt(const std::function<void(const std::vecto
                                        std::vector<double> p, const std::vector<double>& scale, const LmOptions& options,
                                        LmSummary* summary);
 
-// A recording segment with the first `skip` samples excluded from every cost (transient from rest).
+// A recording segment: costs over samples [skip, end) (end = 0: to the end of y); the simulation always
+// starts at sample 0, so the first `skip` samples only warm it up.
 struct Segment {
   const std::vector<double>* u = nullptr;
   const std::vector<double>* y = nullptr;
   std::size_t skip = 0;
+  std::size_t end = 0;
+  std::size_t End() const { return end == 0 || end > y->size() ? y->size() : end; }
+  std::size_t Count() const { return End() > skip ? End() - skip : 0; }
 };
 
 double SumSquaredError(const AugmentedModel& m, const Segment& s);
 
-// Nominal structures users can ask for instead of a model file.
-struct NominalSpec {
-  int na = 2, nb = 2, delay = 0;      // linear: z_t = -sum_{1..na} a z + sum_{0..nb-1} b x_{t-delay-j}
-  int input_degree = 1;               // hw: polynomial input map of this degree (1 = identity)
-  int output_degree = 1;              // hw: polynomial output map of this degree (1 = identity)
-  bool IsValid(std::string* error) const;
-  // "linear:NA,NB[,DELAY]" or "hw:NA,NB,PIN,POUT[,DELAY]"; throws InputError.
-  static NominalSpec Parse(const std::string& text);
-};
-
-// Output-error fit of the nominal structure: ARX, Steiglitz–McBride passes, then Levenberg–Marquardt.
-HwModel FitNominal(const NominalSpec& spec, const Segment& data);
-
 struct RefitOptions {
-  bool refit_maps = true;   // also re-estimate polynomial map coefficients (first coefficient held at its value)
-  bool fit_output_offset = true;  // estimate a constant output offset with every refit (baseline included)
-  int keep_grid_points = 3; // grid points refined by LM
+  bool refit_maps = true;              // also re-estimate polynomial map coefficients (first one held)
+  bool fit_output_offset = true;       // estimate a constant output offset with every refit
+  bool estimate_initial_state = true;  // estimate z_{-1..-na} (recordings that do not start from rest)
+  int keep_grid_points = 3;            // grid points refined by LM
   LmOptions lm;
   bool IsValid(std::string* error) const;
 };
 
 struct RefitResult {
   AugmentedModel model;
-  double sse = 0.0;      // on the fitting segment
+  double sse = 0.0;          // on the fitting segment
   int extra_parameters = 0;  // effect parameters actually estimated (one-sided saturations count 1)
 };
 
-// Refit of the nominal model with no block (the fair baseline: same optimiser, same data).
-RefitResult RefitNominal(const HwModel& nominal, const Segment& data, const RefitOptions& options);
-// Joint refit of one effect block at one location with the model's parameters.
-// `output_offset` is the starting output offset (e.g. the baseline refit's).
-RefitResult RefitWithEffect(const HwModel& nominal, Effect effect, Location location, const Segment& data,
-                            const RefitOptions& options, double output_offset = 0.0);
+// Jointly refits every number of `model` (linear block, maps, offset, initial state, block parameters).
+RefitResult RefitModel(const AugmentedModel& model, const Segment& data, const RefitOptions& options);
+// Which limits of a saturation-type block are estimated (the others stay infinite).
+enum class LimitSides { kAny, kUpper, kLower, kBoth };
+
+// Adds one effect block to `base` (which may already hold one) and refits jointly; a grid over the new
+// block's parameters seeds the optimiser. Returns `base` refitted without the block (extra_parameters
+// 0) when no grid point is admissible.
+RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location location, StateVariable state_variable,
+                     const Segment& data, const RefitOptions& options, LimitSides sides = LimitSides::kAny);
+// Re-estimates only the initial state (and nothing else) of `model` on a recording, e.g. to compare
+// fixed models on a validation recording that does not start from rest. No-op when the linear block
+// has no poles or when `options.estimate_initial_state` is false.
+void EstimateInitialState(AugmentedModel* model, const Segment& data, const RefitOptions& options);
 
 // Reflects roots of A(q) outside the unit circle inside it (keeps the model simulable).
 std::vector<double> StabilisedDenominator(const std::vector<double>& a);
+
+// Least squares ARX on (x, y): y_t = -sum a_i y_{t-i} + sum b_j x_{t-d-j} (+ c when with_constant).
+bool FitArx(const std::vector<double>& x, const std::vector<double>& y, int na, int nb, int d, std::size_t skip,
+            std::size_t end, bool with_constant, std::vector<double>* a, std::vector<double>* b, double* constant);
+
+// Whether the polynomial static maps are monotone over the signals they see for input u (the input map
+// over u's range, the output map over the simulated z's range). Identity maps are monotone.
+bool MapsMonotone(const AugmentedModel& m, const std::vector<double>& u);
+
+// Number of effect parameters of the blocks that are estimated (finite).
+int EffectParameterCount(const AugmentedModel& m);
 
 }  // namespace hw::diagnose

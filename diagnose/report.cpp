@@ -27,8 +27,40 @@ nlohmann::json SampleWindows(const Windows& w) {
 }
 
 std::string Verdict(const DiagnoseReport& r) {
-  return r.verdict == Effect::kNone ? "none"
-                                    : fmt::format("{} at {}", EffectName(r.verdict), LocationName(r.verdict_location));
+  return r.verdict == Effect::kNone ? "none" : r.augmented_model.Label();
+}
+
+// A block's JSON plus its limits in the recording's units where they differ (a state saturation acts
+// on z, which the output map and offset turn into the recorded value).
+nlohmann::json BlockJson(const EffectBlock& b, const AugmentedModel& m) {
+  nlohmann::json j = b.to_json();
+  if (b.effect == Effect::kStateSaturation) {
+    EffectBlock in_units = b;
+    in_units.params = ParametersInRecordingUnits(b, m);
+    j["parameters_in_recording_units"] = in_units.to_json()["parameters"];
+  }
+  const auto force = FrictionLevelsInInputUnits(b, m);
+  if (!force.empty()) j["levels_in_input_units"] = {{"level_up", force[0]}, {"level_down", force[1]}};
+  return j;
+}
+
+std::string ParamTextOf(const Finding& f) {
+  std::string s;
+  for (const auto& b : f.model.blocks)
+    s += fmt::format("{}{} ({})", s.empty() ? "" : " + ", b.Label(), ParameterText(b, f.model));
+  return s;
+}
+
+nlohmann::json StartsJson(const std::vector<NominalStart>& starts) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& s : starts) j.push_back(s.to_json());
+  return j;
+}
+
+nlohmann::json FindingsJson(const std::vector<Finding>& fs) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& f : fs) j.push_back(f.to_json());
+  return j;
 }
 
 // Plot data: one whitespace-separated file, '#' header so gnuplot skips it.
@@ -57,33 +89,67 @@ std::string ShadeWindows(const Windows& w, const std::vector<double>& t) {
 
 }  // namespace
 
+nlohmann::json Finding::to_json() const {
+  nlohmann::json bl = nlohmann::json::array();
+  for (const auto& b : model.blocks) bl.push_back(BlockJson(b, model));
+  const auto first = bl.empty() ? nlohmann::json::object() : bl.front();
+  return {{"label", Label()},
+          {"effect", first.value("effect", "none")},
+          {"location", first.value("location", "")},
+          {"parameters", first.value("parameters", nlohmann::json::object())},
+          {"blocks", bl},
+          {"score", score},
+          {"eligible", eligible},
+          {"evidence",
+           {{"text", evidence},
+            {"holdout", holdout.to_json()},
+            {"validation", validation.to_json()},
+            {"extra_parameters", extra_parameters},
+            {"share_of_improvement_in_residual_windows", in_window_share}}}};
+}
+
 nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const Recording& valid) {
-  nlohmann::json findings = nlohmann::json::array();
-  for (const auto& f : r.findings) findings.push_back(f.to_json());
   std::size_t flagged = 0;
   for (bool m : r.mask) flagged += m;
+  nlohmann::json verdict_blocks = nlohmann::json::array();
+  for (const auto& b : r.verdict_blocks) verdict_blocks.push_back(BlockJson(b, r.augmented_model));
   nlohmann::json j;
   j["tool"] = "hwbounds diagnose";
-  j["schema_version"] = 1;
+  j["schema_version"] = 2;
   j["ok"] = r.ok;
   j["verdict"] = EffectName(r.verdict);
   j["verdict_location"] = r.verdict == Effect::kNone ? nlohmann::json(nullptr) : nlohmann::json(LocationName(r.verdict_location));
+  j["verdict_blocks"] = verdict_blocks;
   j["summary"] = r.message;
-  j["findings"] = findings;
+  j["baseline"] = {{"source", r.baseline_source}, {"starts", StartsJson(r.baseline_starts)},
+                   {"initial_state", r.initial_state_note}};
+  j["findings"] = FindingsJson(r.findings);
+  j["pairs"] = FindingsJson(r.pairs);
   j["mismatch"] = {
+      {"source", r.mask_source},
       {"windows", TimeWindows(r.windows, ident.t)},
       {"window_samples", SampleWindows(r.windows)},
       {"flagged_fraction", r.mask.empty() ? 0.0 : double(flagged) / r.mask.size()},
       {"validation_windows", TimeWindows(r.validation_windows, valid.t)},
+      {"nominal_residual_windows", SampleWindows(MaskToWindows(r.residual_mask))},
+      {"per_block", [&] {
+         nlohmann::json pb = nlohmann::json::array();
+         for (const auto& w : r.block_windows)
+           pb.push_back({{"label", w.label}, {"flagged_fraction", w.fraction},
+                         {"window_samples", SampleWindows(MaskToWindows(w.mask))}});
+         return pb;
+       }()},
       {"region", r.region.to_json()},
       {"noise_std", r.noise_std},
-      {"noise_std_source", r.noise_estimated ? "estimated (1.4826 MAD of residual differences / sqrt 2)" : "given"}};
+      {"noise_std_source", r.noise_estimated ? "estimated (1.4826 MAD of residual differences / sqrt 2, capped by the "
+                                               "best model's RMS error)"
+                                             : "given"}};
   nlohmann::json aug = r.augmented.to_json();
-  aug["effect"] = EffectName(r.augmented_model.block.effect);
+  aug["model"] = r.augmented_model.Label();
   j["fit"] = {{"nominal", r.nominal.to_json()},
               {"nominal_refit", r.nominal_refit.to_json()},
               {"augmented", aug},
-              {"on", "validation recording"},
+              {"on", "validation recording (initial state re-estimated for each model)"},
               {"validation_paired_z", r.validation_z},
               {"nominal_parameters_off", r.parameters_off},
               {"nominal_refit_paired_z", r.refit_z},
@@ -95,11 +161,7 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
       {"augmented_on_validation",
        {{"whiteness", r.whiteness_augmented.to_json()}, {"input_cross_correlation", r.input_corr_augmented.to_json()}}}};
   j["models"] = {{"nominal", r.nominal_model.to_json()},
-                 {"nominal_refit", [&] {
-                    auto m = r.nominal_refit_model.to_json();
-                    m["output_offset"] = r.nominal_refit_offset;
-                    return m;
-                  }()},
+                 {"nominal_refit", r.nominal_refit_model.to_json()},
                  {"augmented", r.augmented_model.to_json()}};
   j["data"] = {{"identification", {{"name", ident.name}, {"samples", ident.y.size()}}},
                {"validation", {{"name", valid.name}, {"samples", valid.y.size()}}}};
@@ -109,14 +171,13 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
 
 std::string ReportMarkdown(const DiagnoseReport& r, const Recording& ident, const Recording& valid) {
   std::string s = "# Discrepancy diagnosis\n\n";
-  s += fmt::format("**Verdict: {}.** {}\n\n", Verdict(r), r.message);
+  s += fmt::format("**Verdict: {}.** {}\n\n", Verdict(r), r.message.substr(r.message.find(' ') + 1));
   s += fmt::format("Identification: `{}` ({} samples); validation: `{}` ({} samples). Run time {:.2f} s.\n\n",
                    ident.name, ident.y.size(), valid.name, valid.y.size(), r.seconds);
   s += "## Where the nominal model differs\n\n";
-  s += fmt::format("Noise standard deviation {:.4g} ({}). {} mismatch window(s) where the local mean-square error "
-                   "exceeds the noise; they are characterised by: **{}**.\n\n",
+  s += fmt::format("Noise standard deviation {:.4g} ({}). {} window(s) of {}; they are characterised by: **{}**.\n\n",
                    r.noise_std, r.noise_estimated ? "estimated from the residual" : "given", r.windows.size(),
-                   r.region.description);
+                   r.mask_source, r.region.description);
   if (!r.windows.empty()) {
     s += "First windows (t_start – t_end): ";
     for (std::size_t i = 0; i < r.windows.size() && i < 12; ++i)
@@ -132,23 +193,30 @@ std::string ReportMarkdown(const DiagnoseReport& r, const Recording& ident, cons
   s += test_row("nominal, identification: cross-correlation with u", r.input_corr_nominal);
   s += test_row("augmented, validation: whiteness", r.whiteness_augmented);
   s += test_row("augmented, validation: cross-correlation with u", r.input_corr_augmented);
-  s += "\n## Candidate effects (ranked on the held-out tail of the identification recording)\n\n";
-  s += "| rank | effect | location | parameters | held-out MSE ratio | score | z | in windows | significant |\n";
-  s += "|---|---|---|---|---|---|---|---|---|\n";
-  int rank = 0;
-  for (const auto& f : r.findings) {
-    std::string p;
-    const auto names = ParameterNames(f.block.effect);
-    for (std::size_t i = 0; i < names.size(); ++i) p += fmt::format("{}{}={:.4g}", i ? ", " : "", names[i], f.block.params[i]);
-    s += fmt::format("| {} | {} | {} | {} | {:.3f} | {:.3f} | {:.1f} | {:.0f} % | {} |\n", ++rank,
-                     EffectName(f.block.effect), LocationName(f.block.location), p, f.mse_ratio, f.score, f.z,
-                     100 * f.in_window_share, f.significant ? "yes" : "no");
-  }
+  s += fmt::format("\n## Baseline\n\nThe nominal model refitted alone: {}. {}.\n\n| start | fit RMSE | held-out RMSE |\n|---|---|---|\n",
+                   r.baseline_source, r.initial_state_note);
+  for (const auto& st : r.baseline_starts)
+    s += fmt::format("| {} | {:.5g} | {:.5g} |\n", st.name, st.fit_rmse, st.holdout_rmse);
+  auto table = [&](const std::vector<Finding>& fs) {
+    std::string t = "| rank | blocks | held-out MSE ratio | z | validation MSE ratio | z | score | eligible |\n";
+    t += "|---|---|---|---|---|---|---|---|\n";
+    int rank = 0;
+    for (const auto& f : fs)
+      t += fmt::format("| {} | {} | {:.3f} | {:.1f} | {:.3f} | {:.1f} | {:.3f} | {} |\n", ++rank, ParamTextOf(f),
+                       f.holdout.ratio, f.holdout.z, f.validation.ratio, f.validation.z, f.score,
+                       f.eligible ? "yes" : "no");
+    return t;
+  };
+  s += "\n## Candidate effects\n\nEach block is fitted on the first part of the identification recording, scored on "
+       "its held-out tail, refitted on the whole recording and scored on the validation recording (ratios to the "
+       "baseline; score = 1 - geometric mean of the penalised ratios).\n\n";
+  s += table(r.findings);
+  if (!r.pairs.empty()) s += "\n### Combinations with the best block (ratios to that block alone)\n\n" + table(r.pairs);
   s += fmt::format("\n{}\n\n## Fit on the validation recording\n\n", r.validation_note);
   s += "| model | RMSE | fit % |\n|---|---|---|\n";
   s += fmt::format("| nominal (as given / fitted) | {:.5g} | {:.2f} |\n", r.nominal.rmse, r.nominal.fit_percent);
   s += fmt::format("| nominal, linear part refitted | {:.5g} | {:.2f} |\n", r.nominal_refit.rmse, r.nominal_refit.fit_percent);
-  s += fmt::format("| augmented ({}) | {:.5g} | {:.2f} |\n\n", EffectName(r.augmented_model.block.effect), r.augmented.rmse,
+  s += fmt::format("| augmented ({}) | {:.5g} | {:.2f} |\n\n", r.augmented_model.Label(), r.augmented.rmse,
                    r.augmented.fit_percent);
   s += "## Figures\n\n![identification](identification.png)\n\n![validation](validation.png)\n\n"
        "![residual against the operating condition](residual_vs_condition.png)\n\n![residual in time](residual_time.png)\n";
@@ -195,13 +263,14 @@ std::vector<std::string> WriteReport(const DiagnoseReport& r, const Recording& i
     written.push_back(p);
   }
   const std::string verdict = Verdict(r);
+  const std::string shade = r.verdict == Effect::kNone ? "residual beyond the noise" : "where the verdict acts";
   std::string gp = "set terminal pngcairo size 1200,500 noenhanced\nset grid\nset key outside top center horizontal\n";
   gp += ShadeWindows(r.windows, ident.t);
   gp += fmt::format(
-      "set output 'identification.png'\nset title 'Identification: y, nominal and augmented ({}) simulations; shaded = nominal error beyond the noise'\nset xlabel 't'\nset ylabel 'y'\n"
+      "set output 'identification.png'\nset title 'Identification: y and simulations, augmented = {}; shaded = {}'\nset xlabel 't'\nset ylabel 'y'\n"
       "plot 'identification.dat' u 1:2 w l lc rgb '#999999' t 'y measured', '' u 1:3 w l lw 1.5 lc rgb '#d62728' t "
       "'nominal', '' u 1:4 w l lw 1.5 lc rgb '#1f77b4' t 'augmented'\n",
-      verdict);
+      verdict, shade);
   gp += fmt::format(
       "set output 'residual_time.png'\nset title 'Simulation error on the identification recording (±3 sigma "
       "noise band)'\nset ylabel 'y - yhat'\nplot 'identification.dat' u 1:5 w l lc rgb '#d62728' t 'nominal', '' u "
@@ -209,7 +278,7 @@ std::vector<std::string> WriteReport(const DiagnoseReport& r, const Recording& i
       "rgb 'black' t '-3 sigma'\n",
       3 * r.noise_std);
   gp += ShadeWindows(r.validation_windows, valid.t);
-  gp += "set output 'validation.png'\nset title 'Validation: y, nominal and augmented simulations; shaded = nominal error beyond the noise'\nset ylabel 'y'\n"
+  gp += "set output 'validation.png'\nset title 'Validation: y and simulations; shaded = " + shade + "'\nset ylabel 'y'\n"
         "plot 'validation.dat' u 1:2 w l lc rgb '#999999' t 'y measured', '' u 1:3 w l lw 1.5 lc rgb '#d62728' t "
         "'nominal', '' u 1:4 w l lw 1.5 lc rgb '#1f77b4' t 'augmented'\n";
   if (cond) {

@@ -49,11 +49,17 @@ double EstimateNoiseStd(const std::vector<double>& e, std::size_t skip) {
 }
 
 bool WindowOptions::IsValid(std::string* error) const {
-  if (length < 0 || length == 1 || !(z > 0)) {
-    if (error) *error = "window length must be 0 (auto) or >= 2, and z > 0";
+  if (length < 0 || length == 1 || !(alpha > 0 && alpha < 1)) {
+    if (error) *error = "window length must be 0 (auto) or >= 2, and alpha in (0, 1)";
     return false;
   }
   return true;
+}
+
+double WindowOptions::Threshold(std::size_t n) const {
+  const int L = Resolve(n);
+  const double windows = std::max(1.0, static_cast<double>(n) / L);
+  return ChiSquareQuantile(1.0 - alpha / windows, L) / L;
 }
 
 int WindowOptions::Resolve(std::size_t n) const {
@@ -66,7 +72,7 @@ std::vector<bool> MismatchMask(const std::vector<double>& e, double sigma, std::
   const int L = o.Resolve(n);
   std::vector<bool> mask(n, false);
   if (n < skip + L || !(sigma > 0)) return mask;
-  const double thr = sigma * sigma * (1.0 + o.z * std::sqrt(2.0 / L));
+  const double thr = sigma * sigma * o.Threshold(n - skip);
   std::vector<double> cs(n + 1, 0.0);
   for (std::size_t t = 0; t < n; ++t) cs[t + 1] = cs[t] + (t >= skip ? e[t] * e[t] : 0.0);
   for (std::size_t s = skip; s + L <= n; ++s) {
@@ -131,7 +137,8 @@ nlohmann::json Region::to_json() const {
 }
 
 namespace {
-void FindBias(const std::vector<Condition>& conditions, const std::vector<double>& e, std::size_t skip, Region* r) {
+void FindBias(const std::vector<Condition>& conditions, const std::vector<double>& e, std::size_t skip,
+              const std::string& subject, Region* r) {
   double mean = 0.0, var = 0.0;
   const double nall = static_cast<double>(e.size() - skip);
   for (std::size_t t = skip; t < e.size(); ++t) mean += e[t];
@@ -165,22 +172,22 @@ void FindBias(const std::vector<Condition>& conditions, const std::vector<double
   const bool dir = b.condition == "dir_u" || b.condition == "dir_y";
   const std::string sig = b.condition.find('u') != std::string::npos ? "u" : "y";
   b.condition == "dir_u" || b.condition == "dir_y"
-      ? r->bias.description = fmt::format("the error's sign follows the direction of {}: mean {:+.4g} after {} rose, {:+.4g} after it fell "
-                                          "({:.2f} error standard deviations apart)", sig, b.mean_above, sig, b.mean_below, b.effect_size)
-      : r->bias.description = fmt::format("the mean error changes across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} error "
-                                          "standard deviations apart)", b.condition, b.threshold, b.mean_above, b.mean_below, b.effect_size);
+      ? r->bias.description = fmt::format("the {0}'s sign follows the direction of {1}: mean {2:+.4g} after {1} rose, {3:+.4g} after it fell "
+                                          "({4:.2f} {0} standard deviations apart)", subject, sig, b.mean_above, b.mean_below, b.effect_size)
+      : r->bias.description = fmt::format("the mean {} differs across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} {} "
+                                          "standard deviations apart)", subject, b.condition, b.threshold, b.mean_above, b.mean_below, b.effect_size, subject);
   (void)dir;
 }
 }  // namespace
 
 Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::vector<bool>& mask,
-                          const std::vector<double>& e, std::size_t skip) {
+                          const std::vector<double>& e, std::size_t skip, const std::string& subject) {
   Region best;
-  best.description = "none: the error stays within the noise everywhere";
+  best.description = fmt::format("none: the {} stays within the noise everywhere", subject);
   std::size_t nmask = 0;
   for (std::size_t t = skip; t < mask.size(); ++t) nmask += mask[t];
   if (nmask == 0) return best;
-  FindBias(conditions, e, skip, &best);
+  FindBias(conditions, e, skip, subject, &best);
   // When the mask covers most samples it no longer separates anything: rank rules by how much more
   // of the squared error than of the samples they capture instead.
   const bool informative = nmask < 0.6 * (mask.size() - skip);
@@ -231,7 +238,7 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
     }
   }
   if (!best.found) {
-    best.description = "no single operating condition characterises the mismatch windows";
+    best.description = "no single operating condition characterises the flagged samples";
     if (best.bias.found) best.description += "; " + best.bias.description;
     return best;
   }
@@ -251,13 +258,13 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
     d = fmt::format("{} {} {}", label.count(n) ? label.at(n) : n, above ? "above" : "at or below", th);
   }
   if (informative)
-    best.description = fmt::format("{} (covers {:.0f} % of the mismatch samples; {:.0f} % of the samples meeting it "
-                                   "are mismatched; mean-square error there {:.1f}x elsewhere)",
-                                   d, 100 * best.recall, 100 * best.precision, best.lift);
+    best.description = fmt::format("{} (covers {:.0f} % of the flagged samples; {:.0f} % of the samples meeting it "
+                                   "are flagged; mean-square {} there {:.1f}x elsewhere)",
+                                   d, 100 * best.recall, 100 * best.precision, subject, best.lift);
   else
-    best.description = fmt::format("error beyond the noise almost everywhere ({:.0f} % of the samples); it is largest "
-                                   "for {} (mean-square error there {:.1f}x elsewhere)",
-                                   100.0 * nmask / nall, d, best.lift);
+    best.description = fmt::format("{} beyond the noise almost everywhere ({:.0f} % of the samples); it is largest "
+                                   "for {} (mean-square {} there {:.1f}x elsewhere)",
+                                   subject, 100.0 * nmask / nall, d, subject, best.lift);
   if (best.bias.found) best.description += "; " + best.bias.description;
   return best;
 }

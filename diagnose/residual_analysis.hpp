@@ -16,9 +16,13 @@ double EstimateNoiseStd(const std::vector<double>& e, std::size_t skip);
 
 struct WindowOptions {
   int length = 0;           // sliding-window length in samples; 0 = auto (N/200 clamped to [8, 40])
-  double z = 3.0;           // local mean square must exceed sigma^2 (1 + z sqrt(2/L))
+  // Family-wise false-alarm probability over the recording's N/L disjoint windows: a window is flagged
+  // when its mean square exceeds sigma^2 chi^2_L(1 - alpha L / N) / L (Bonferroni), so that a recording
+  // the model explains is flagged nowhere with probability about 1 - alpha.
+  double alpha = 0.05;
   bool IsValid(std::string* error) const;
   int Resolve(std::size_t n) const;
+  double Threshold(std::size_t n) const;  // in units of sigma^2
 };
 
 // Samples (mask) and merged [start, end] index windows where the local mean-square error exceeds the noise.
@@ -54,9 +58,10 @@ struct Region {
   nlohmann::json to_json() const;
 };
 // The single threshold rule on one condition that best matches the mismatch mask (F1), weighted by
-// the squared error so that a rule must also concentrate the error.
+// the squared signal e so that a rule must also concentrate it. `subject` names e in the text
+// ("error" for a residual, "change" for what an effect block changes in the prediction).
 Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::vector<bool>& mask,
-                          const std::vector<double>& e, std::size_t skip);
+                          const std::vector<double>& e, std::size_t skip, const std::string& subject = "error");
 
 struct CorrelationTest {
   double statistic = 0.0;  // N sum rho^2

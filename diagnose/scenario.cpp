@@ -71,9 +71,11 @@ bool ScenarioOptions::IsValid(std::string* error) const {
 }
 
 nlohmann::json Scenario::truth_json() const {
-  return {{"effect", EffectName(truth.block.effect)},
-          {"location", truth.block.effect == Effect::kNone ? "none" : LocationName(truth.block.location)},
-          {"block", truth.block.to_json()},
+  nlohmann::json blocks = nlohmann::json::array();
+  for (const auto& b : truth.blocks) blocks.push_back(b.to_json());
+  return {{"effect", EffectName(truth.effect())},
+          {"location", truth.has_block() ? LocationName(truth.blocks.front().location) : "none"},
+          {"blocks", blocks},
           {"noise_std", noise_std},
           {"effect_rms", effect_rms},
           {"model", truth.to_json()}};
@@ -100,7 +102,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
   const double frac = o.effect_fraction > 0 ? o.effect_fraction : 0.04 + 0.04 * U(rng);
   const double target = frac * StdDev(w_lin);
 
-  AugmentedModel truth{lin, {}};
+  AugmentedModel truth{lin, {}, 0.0, {}};
   if (o.effect != Effect::kNone) {
     const Location loc = o.location < 0 ? DefaultLocation(o.effect) : static_cast<Location>(o.location);
     const Vec& lv = loc == Location::kInput ? u_id : w_lin;
@@ -115,6 +117,8 @@ Scenario MakeScenario(const ScenarioOptions& o) {
     const double force = Rms(LinearBlock{{}, lin.linear.b, 0}.simulate(u_id));
     const double zr = Rms(w_lin);
     const int k_delay = 1 + static_cast<int>(o.seed % 3);
+    const double asymmetry = 0.6 + 0.4 * U(rng);    // friction level down / level up
+    const double stick_ratio = 0.3 + 0.4 * U(rng);  // kinetic / static band of a sticky valve
     auto block_for = [&](double s) -> EffectBlock {
       switch (o.effect) {
         case Effect::kBacklash:
@@ -135,8 +139,10 @@ Scenario MakeScenario(const ScenarioOptions& o) {
           return {o.effect, loc, {std::max(1e-6, s * 0.5 * range)}};
         case Effect::kHysteresis:
           return {o.effect, loc, {beta, s * 0.5 * StdDev(u_id)}};
+        case Effect::kStiction:
+          return {o.effect, loc, {s * 0.3 * range, s * 0.3 * range * stick_ratio}};
         case Effect::kCoulombFriction:
-          return {o.effect, loc, {s * 0.5 * force}};
+          return {o.effect, loc, {s * 0.5 * force, s * 0.5 * force * asymmetry}};
         case Effect::kCubicStiffness:
           return {o.effect, loc, {s * 0.5 * force / (zr * zr * zr)}};
         default:
@@ -144,7 +150,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
       }
     };
     auto contrib_rms = [&](double s) {
-      AugmentedModel m{lin, block_for(s)};
+      AugmentedModel m{lin, {block_for(s)}, 0.0, {}};
       bool ok = true;
       const Vec c = Contribution(m, lin, u_id, &ok);
       return ok ? Rms(c) : HUGE_VAL;
@@ -157,7 +163,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
       }
       s = 0.5 * (lo + hi);
     }
-    truth.block = block_for(s);
+    truth.blocks = {block_for(s)};
   }
   sc.truth = truth;
   bool ok = true;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "diagnose/locate.hpp"
 
 namespace hw::diagnose {
 
@@ -43,20 +44,21 @@ StudyResult RunStudy(const StudyOptions& o) {
     so.samples = o.samples;
     so.effect_rms_ratio = ratio;
     const Scenario sc = MakeScenario(so);
-    const HwModel nominal =
-        design ? sc.linear_truth : FitNominal(spec, {&sc.ident.u, &sc.ident.y, o.diagnose.init_samples});
+    const Segment seg{&sc.ident.u, &sc.ident.y, o.diagnose.init_samples, 0};
+    const AugmentedModel nominal = design ? AugmentedModel{sc.linear_truth, {}, 0.0, {}}
+                                          : FitNominal(spec, seg, o.diagnose.nominal_fit).model;
     DiagnoseReport r;
-    Diagnose(o.diagnose, nominal, sc.ident, sc.valid, &r);
+    Diagnose(o.diagnose, nominal, design ? nullptr : &spec, sc.ident, sc.valid, &r);
     StudyCase c;
     c.truth = effect;
-    c.truth_location = sc.truth.block.location;
+    c.truth_location = sc.truth.has_block() ? sc.truth.blocks.front().location : Location::kInput;
     c.seed = seed;
     c.ratio = ratio;
     c.verdict = r.verdict;
     c.verdict_location = r.verdict_location;
-    const bool refit_better = r.nominal_refit.rmse < r.nominal.rmse;
-    c.fit_nominal = refit_better ? r.nominal_refit.fit_percent : r.nominal.fit_percent;
-    c.rmse_nominal = refit_better ? r.nominal_refit.rmse : r.nominal.rmse;
+    c.verdict_label = r.verdict == Effect::kNone ? "none" : r.augmented_model.Label();
+    c.fit_nominal = r.nominal_refit.fit_percent;
+    c.rmse_nominal = r.nominal_refit.rmse;
     c.fit_augmented = r.augmented.fit_percent;
     c.rmse_augmented = r.augmented.rmse;
     std::size_t both = 0;
@@ -67,6 +69,7 @@ StudyResult RunStudy(const StudyOptions& o) {
     }
     c.window_precision = c.flagged ? double(both) / c.flagged : 0.0;
     c.window_recall = c.active ? double(both) / c.active : 0.0;
+    c.window_iou = IntersectionOverUnion(r.mask, sc.ident_active, o.diagnose.init_samples);
     c.seconds = r.seconds;
     c.row = row;
     res.cases.push_back(c);
@@ -83,31 +86,38 @@ StudyResult RunStudy(const StudyOptions& o) {
     const auto it = std::find(res.labels.begin(), res.labels.end(), EffectName(e));
     return it == res.labels.end() ? k - 1 : static_cast<std::size_t>(it - res.labels.begin());
   };
-  int correct = 0, nulls = 0, alarms = 0, located = 0, detected_right = 0, with_effect = 0;
-  double prec = 0.0, rec = 0.0, gain = 0.0;
+  int correct = 0, located = 0, detected_right = 0, with_effect = 0, named_right = 0, named_right_iou_n = 0;
+  double prec = 0.0, rec = 0.0, gain = 0.0, iou = 0.0, iou_right = 0.0, null_flagged = 0.0;
   for (const auto& c : res.cases) {
     ++res.confusion[c.row][index(c.verdict)];
     correct += c.truth == c.verdict;
     if (c.truth == Effect::kNone) {
-      ++nulls;
-      alarms += c.verdict != Effect::kNone;
-    } else {
-      ++with_effect;
-      prec += c.window_precision;
-      rec += c.window_recall;
-      gain += c.fit_augmented - c.fit_nominal;
-      if (c.truth == c.verdict) {
-        ++detected_right;
-        located += c.truth_location == c.verdict_location;
-      }
+      ++res.null_cases;
+      res.false_alarms += c.verdict != Effect::kNone;
+      null_flagged += c.flagged / static_cast<double>(std::max<std::size_t>(1, o.samples - o.diagnose.init_samples));
+      continue;
+    }
+    ++with_effect;
+    prec += c.window_precision;
+    rec += c.window_recall;
+    gain += c.fit_augmented - c.fit_nominal;
+    iou += c.window_iou;
+    if (c.truth == c.verdict) {
+      ++detected_right;
+      located += c.truth_location == c.verdict_location;
+      if (c.truth_location == c.verdict_location) ++named_right, iou_right += c.window_iou, ++named_right_iou_n;
     }
   }
   res.accuracy = res.cases.empty() ? 0.0 : double(correct) / res.cases.size();
-  res.false_alarm_rate = nulls ? double(alarms) / nulls : 0.0;
+  res.false_alarm_rate = res.null_cases ? double(res.false_alarms) / res.null_cases : 0.0;
   res.location_accuracy = detected_right ? double(located) / detected_right : 0.0;
+  res.named_right_rate = with_effect ? double(named_right) / with_effect : 0.0;
   res.mean_window_precision = with_effect ? prec / with_effect : 0.0;
   res.mean_window_recall = with_effect ? rec / with_effect : 0.0;
   res.mean_fit_gain = with_effect ? gain / with_effect : 0.0;
+  res.mean_window_iou = with_effect ? iou / with_effect : 0.0;
+  res.mean_window_iou_named_right = named_right_iou_n ? iou_right / named_right_iou_n : 0.0;
+  res.mean_null_flagged_fraction = res.null_cases ? null_flagged / res.null_cases : 0.0;
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
@@ -125,6 +135,8 @@ nlohmann::json StudyResult::to_json() const {
                   {"validation_fit_augmented", c.fit_augmented},
                   {"validation_rmse_nominal", c.rmse_nominal},
                   {"validation_rmse_augmented", c.rmse_augmented},
+                  {"verdict_label", c.verdict_label},
+                  {"window_iou", c.window_iou},
                   {"window_precision", c.window_precision},
                   {"window_recall", c.window_recall},
                   {"flagged_samples", c.flagged},
@@ -136,6 +148,12 @@ nlohmann::json StudyResult::to_json() const {
           {"accuracy", accuracy},
           {"false_alarm_rate", false_alarm_rate},
           {"location_accuracy", location_accuracy},
+          {"named_right_rate", named_right_rate},
+          {"false_alarms", false_alarms},
+          {"null_cases", null_cases},
+          {"mean_window_iou", mean_window_iou},
+          {"mean_window_iou_named_right", mean_window_iou_named_right},
+          {"mean_null_flagged_fraction", mean_null_flagged_fraction},
           {"mean_window_precision", mean_window_precision},
           {"mean_window_recall", mean_window_recall},
           {"mean_validation_fit_gain", mean_fit_gain},
@@ -155,11 +173,15 @@ std::string StudyResult::to_markdown() const {
     s += "\n";
   }
   s += fmt::format(
-      "\nScenarios: {}; accuracy {:.1f} %; false-alarm rate on null scenarios {:.1f} %; location correct in {:.1f} % of "
-      "the correct verdicts; mismatch windows vs truly active samples (|effect| > noise std): precision {:.2f}, recall "
-      "{:.2f}; mean validation fit gain {:+.2f} points; total run time {:.1f} s ({:.2f} s per scenario).\n",
-      cases.size(), 100 * accuracy, 100 * false_alarm_rate, 100 * location_accuracy, mean_window_precision,
-      mean_window_recall, mean_fit_gain, seconds, cases.empty() ? 0.0 : seconds / cases.size());
+      "\nScenarios: {} ({} with an effect, {} null). Effect named right (name and location): {:.1f} %; false alarms: "
+      "{} of {} null scenarios (mean flagged fraction there {:.2f} %); accuracy over all scenarios {:.1f} %; location "
+      "correct in {:.1f} % of the correctly named effects. Windows vs the samples where the effect moves the output by "
+      "more than the noise: mean IoU {:.2f} over all effect scenarios ({:.2f} over those named right), precision "
+      "{:.2f}, recall {:.2f}. Mean validation fit gain {:+.2f} points; run time {:.1f} s ({:.2f} s per scenario).\n",
+      cases.size(), cases.size() - null_cases, null_cases, 100 * named_right_rate, false_alarms, null_cases,
+      100 * mean_null_flagged_fraction, 100 * accuracy, 100 * location_accuracy, mean_window_iou,
+      mean_window_iou_named_right, mean_window_precision, mean_window_recall, mean_fit_gain, seconds,
+      cases.empty() ? 0.0 : seconds / cases.size());
   return s;
 }
 

@@ -1,4 +1,6 @@
 // hwbounds.diagnose and hwbounds.scenario: discrepancy diagnosis (docs/diagnose.md), as the CLI runs it.
+#include <fmt/format.h>
+
 #include "core/hw_model.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/scenario.hpp"
@@ -36,17 +38,21 @@ py::object Diagnose(py::handle ident_arg, py::handle valid_arg, py::handle model
   const auto valid = RecordingArg(valid_arg, "valid");
   diagnose::DiagnoseReport report;
   if (!model.is_none()) {
-    const HwModel nominal =
-        py::isinstance<py::str>(model) ? HwModel::load(model.cast<std::string>()) : HwModel::from_json(ToJson(model));
+    const diagnose::AugmentedModel nominal = py::isinstance<py::str>(model)
+                                                 ? diagnose::AugmentedModel::Load(model.cast<std::string>())
+                                                 : diagnose::AugmentedModel::from_json(ToJson(model));
+    if (nominal.has_block())
+      throw InputError(fmt::format("diagnose: the model holds effect blocks ({}); give the nominal model without them",
+                                   nominal.Label()));
     WithoutGil([&] {
-      diagnose::Diagnose(o, nominal, ident, valid, &report);
+      diagnose::Diagnose(o, nominal, nullptr, ident, valid, &report);
       return 0;
     });
   } else {
     const auto spec = diagnose::NominalSpec::Parse(fit.cast<std::string>());
     WithoutGil([&] {
-      const HwModel nominal = diagnose::FitNominal(spec, {&ident.u, &ident.y, o.init_samples});
-      diagnose::Diagnose(o, nominal, ident, valid, &report);
+      const diagnose::NominalFit nominal = diagnose::FitNominal(spec, {&ident.u, &ident.y, o.init_samples, 0}, o.nominal_fit);
+      diagnose::Diagnose(o, nominal.model, &spec, ident, valid, &report);
       return 0;
     });
   }
@@ -64,8 +70,9 @@ void DefineDiagnose(py::module_& m) {
       "diagnose",
       [](py::handle ident, py::handle valid, py::handle model, py::handle fit, py::handle effects, double noise_std,
          std::size_t init_samples, double holdout_fraction, double significance_z, double min_improvement,
-         double validation_z, int max_validated, int max_lag, int window_length, double window_z, bool refit_maps,
-         bool fit_output_offset, int keep_grid_points, py::handle out_dir) {
+         double validation_z, bool try_pairs, int pair_partners, int max_lag, int threads,
+         const std::string& state_variable, int window_length, double window_alpha, bool refit_maps,
+         bool fit_output_offset, bool estimate_initial_state, int keep_grid_points, py::handle out_dir) {
         diagnose::DiagnoseOptions o;
         o.noise_std = noise_std;
         o.init_samples = init_samples;
@@ -73,12 +80,17 @@ void DefineDiagnose(py::module_& m) {
         o.significance_z = significance_z;
         o.min_improvement = min_improvement;
         o.validation_z = validation_z;
-        o.max_validated = max_validated;
+        o.try_pairs = try_pairs;
+        o.pair_partners = pair_partners;
         o.max_lag = max_lag;
+        o.threads = threads;
+        o.state_variable = diagnose::ParseStateVariable(state_variable);
         o.windows.length = window_length;
-        o.windows.z = window_z;
+        o.windows.alpha = window_alpha;
         o.refit.refit_maps = refit_maps;
         o.refit.fit_output_offset = fit_output_offset;
+        o.refit.estimate_initial_state = estimate_initial_state;
+        o.nominal_fit.refit.estimate_initial_state = estimate_initial_state;
         o.refit.keep_grid_points = keep_grid_points;
         return Diagnose(ident, valid, model, fit, effects, o, out_dir);
       },
@@ -87,15 +99,18 @@ simulation differs from the identification recording, which effect it leaves out
 improves the validation recording. ident, valid: recordings (spec strings such as "rec.mat:u=vir,y=qm,t=time",
 {"u": array, "y": array[, "t": array]} or (u, y)). Exactly one of model (Model JSON dict or file) and fit
 ("linear:NA,NB[,DELAY]" or "hw:NA,NB,PIN,POUT[,DELAY]"). effects: "backlash@input,..." or a list of such.
-Options mirror diagnose::DiagnoseOptions (window_* = windows, refit_maps etc. = refit). out_dir: also write
+Options mirror diagnose::DiagnoseOptions (window_* = windows, refit_maps etc. = refit; estimate_initial_state
+also applies to the nominal fit). out_dir: also write
 the CLI's report files there. Returns report.json as a dict.)doc",
       py::arg("ident"), py::arg("valid"), py::arg("model") = py::none(), py::arg("fit") = py::none(), py::kw_only(),
       py::arg("effects") = py::none(), py::arg("noise_std") = d.noise_std, py::arg("init_samples") = d.init_samples,
       py::arg("holdout_fraction") = d.holdout_fraction, py::arg("significance_z") = d.significance_z,
       py::arg("min_improvement") = d.min_improvement, py::arg("validation_z") = d.validation_z,
-      py::arg("max_validated") = d.max_validated, py::arg("max_lag") = d.max_lag,
-      py::arg("window_length") = d.windows.length, py::arg("window_z") = d.windows.z,
+      py::arg("try_pairs") = d.try_pairs, py::arg("pair_partners") = d.pair_partners, py::arg("max_lag") = d.max_lag,
+      py::arg("threads") = d.threads, py::arg("state_variable") = "position",
+      py::arg("window_length") = d.windows.length, py::arg("window_alpha") = d.windows.alpha,
       py::arg("refit_maps") = d.refit.refit_maps, py::arg("fit_output_offset") = d.refit.fit_output_offset,
+      py::arg("estimate_initial_state") = d.refit.estimate_initial_state,
       py::arg("keep_grid_points") = d.refit.keep_grid_points, py::arg("out_dir") = py::none());
 
   const diagnose::ScenarioOptions s;

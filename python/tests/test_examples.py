@@ -24,5 +24,5 @@ def test_bounds_example_covers_the_truth_and_plots(tmp_path):
 
 def test_diagnose_example_finds_the_backlash_in_the_mat_file(tmp_path):
     out = run_example("diagnose_mat.py", tmp_path)
-    assert "verdict: backlash at input" in out, out
+    assert "verdict: backlash@input" in out, out
     assert (tmp_path / "backlash_pair.mat").exists() and (tmp_path / "report" / "report.json").exists()
