@@ -124,7 +124,7 @@ void DefineBounds(py::module_& m) {
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
          std::string output_basis, int horizon, int order, bool strictly_proper, py::handle box, std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
-         bool lp_screen, bool retry_with_other_solver, int contraction_passes, double contraction_min_shrink,
+         bool edge_witnesses, bool lp_screen, bool retry_with_other_solver, int contraction_passes, double contraction_min_shrink,
          int contraction_max_rounds, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
          py::object progress, std::string source) {
         BoundsArgs a;
@@ -142,6 +142,7 @@ void DefineBounds(py::module_& m) {
         op.run_dir = std::move(run_dir);
         op.parameters = std::move(parameters);
         op.cheap_pass = cheap_pass;
+        op.edge_witness.enabled = edge_witnesses;
         op.lp_screen = lp_screen;
         op.retry_with_other_solver = retry_with_other_solver;
         op.contraction_passes = contraction_passes;
@@ -166,7 +167,8 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("order") = o.order, py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
       py::arg("box") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
       py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
-      py::arg("cheap_pass") = o.cheap_pass, py::arg("lp_screen") = o.lp_screen,
+      py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,
+      py::arg("lp_screen") = o.lp_screen,
       py::arg("retry_with_other_solver") = o.retry_with_other_solver,
       py::arg("contraction_passes") = o.contraction_passes,
       py::arg("contraction_min_shrink") = o.contraction_min_shrink,

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "relax/inner_points.hpp"
 #include "relax/constraint_generation.hpp"
 #include "relax/moment_lp.hpp"
 #include "relax/row_reduction.hpp"
@@ -35,7 +36,7 @@ std::string other_solver(const std::string& s) { return s == "csdp" ? "sdpa" : "
 nlohmann::json JobOutcome::to_json() const {
   return {{"status", status}, {"bound", bound}, {"tight", tight}, {"message", message}, {"rounds", rounds},
           {"sdp_iterations", sdp_iterations}, {"seconds", seconds}, {"moments", moments}, {"blocks", blocks},
-          {"working_set", working_set}, {"verification", verification}, {"float_bound", float_bound},
+          {"working_set", working_set}, {"active_set", active_set}, {"verification", verification}, {"float_bound", float_bound},
           {"correction", correction}, {"verify_seconds", verify_seconds}, {"origin", origin},
           {"bound_round", bound_round}, {"unfinished", unfinished}};
 }
@@ -52,6 +53,7 @@ JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
   o.moments = j.at("moments");
   o.blocks = j.at("blocks");
   o.working_set = j.at("working_set").get<std::vector<int>>();
+  if (j.contains("active_set")) o.active_set = j.at("active_set").get<std::vector<int>>();
   o.verification = j.at("verification");
   o.float_bound = j.at("float_bound");
   o.correction = j.at("correction");
@@ -161,6 +163,23 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
                             {"verification", sdp::ToString(cert.status)}}
           .dump();
     }
+    if (kind == "witness") {
+      // Local extreme of one objective from the given starts in turn, until a start gives a feasible point.
+      const std::vector<int> rows = spec.at("rows").get<std::vector<int>>();
+      const int param = spec.at("param"), dir = spec.at("dir");
+      nlohmann::json answer{{"found", false}, {"solves", 0}};
+      for (const auto& start : spec.at("starts")) {
+        const auto w = LocalExtreme(prior_set, l, param, dir, start.get<std::vector<double>>(), options.edge_witness.local,
+                                    &rows);
+        answer["solves"] = answer["solves"].get<int>() + 1;
+        if (w.found) {
+          answer["found"] = true;
+          answer["point"] = w.point;
+          break;
+        }
+      }
+      return answer.dump();
+    }
     const Box box = spec.at("box").get<Box>();
     const HwOuterSet& set = set_for(box);
     const auto& all_rows = rows_for(box, l);
@@ -204,8 +223,10 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
                               : fmt::format("{} {:.6g}{}", obj.dir < 0 ? ">=" : "<=",
                                             set.scaling().to_original(obj.param, r.bound),
                                             r.bound_verified ? " (verified)" : "");
-      options.round_log(fmt::format("[{}] round {}: {} blocks + {} linear rows, {} ({:.1f} s), {} violated, bound {}",
-                                    label, r.round, r.blocks, r.linear_rows, r.status, r.seconds,
+      options.round_log(fmt::format("[{}] round {}: {} blocks{} + {} linear rows, {} ({:.1f} s), {} violated, bound {}",
+                                    label, r.round, r.blocks,
+                                    r.active < 0 ? std::string() : fmt::format(" ({} active)", r.active),
+                                    r.linear_rows, r.status, r.seconds,
                                     r.violated < 0 ? std::string("-") : std::to_string(r.violated), bound));
     };
     const auto r = SolveWithConstraintGeneration(gen, core, candidates, spec.at("initial").get<std::vector<int>>(),
@@ -217,6 +238,7 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     out.moments = r.num_moments;
     out.blocks = r.num_blocks;
     out.working_set = r.working_set;
+    out.active_set = r.active_set;
     out.message = r.message;
     out.tight = r.tight;
     out.verification = sdp::ToString(r.verification.status);

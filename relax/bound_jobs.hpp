@@ -4,6 +4,9 @@
 // on which worker runs it or when, so results do not depend on timing:
 //   {"kind": "lp", "l"}                          LP screen of orthant l (emptiness, verified);
 //   {"kind": "reduce", "l"}                      exact row reduction of orthant l (relax/row_reduction.hpp);
+//   {"kind": "witness", "l", "param", "dir", "starts", "rows"}
+//                                                a feasible local extreme of a parameter over orthant l, from the
+//                                                starts in turn, over the data rows `rows` (relax/edge_witness.hpp);
 //   {"kind": "relax", "l", "param", "dir", "d", "box", "rows", "initial", ["max_rounds"]}
 //                                                bound min (dir -1) / max (+1) of a parameter over orthant l at
 //                                                order d in `box`, over the data rows `rows`, starting with blocks
@@ -43,6 +46,7 @@ struct JobOutcome {
   double seconds = 0.0;
   std::size_t moments = 0, blocks = 0;
   std::vector<int> working_set;  // indices into the job's rows that had blocks in the last LMI
+  std::vector<int> active_set;   // the part of it with non-negligible multipliers (warm start of other jobs)
   // "off", "verified", "unverified"; bound is the verified value when verified, float_bound the solver's.
   std::string verification = "off";
   double float_bound = 0.0, correction = 0.0, verify_seconds = 0.0;

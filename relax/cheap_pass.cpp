@@ -12,33 +12,46 @@ namespace {
 
 // One pass: seeds first, then the other objectives from the seeds' blocks. `seed_rows` (data-row indices per
 // orthant) are the blocks the seeds start from.
-PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& objectives, std::vector<OrthantWork>& orthants,
-                        int order, int max_rounds, const std::string& phase,
+PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& settled,
+                        std::vector<OrthantWork>& orthants, int order, int max_rounds, const std::string& phase,
                         const std::map<int, std::vector<int>>& seed_rows) {
   PassOutcomes out;
+  const int num_objectives = static_cast<int>(objectives.size());
+  auto is_settled = [&](int l, int j) { return settled.count({l, j}) > 0; };
   int total = 0;
   for (const auto& o : orthants)
-    if (!o.empty()) total += static_cast<int>(objectives.size());
+    if (!o.empty())
+      for (int j = 0; j < num_objectives; ++j) total += is_settled(o.index, j) ? 0 : 1;
   ctx.progress.Phase(phase, total);
   std::vector<RelaxJob> seeds;
+  std::vector<int> seed_objective;
   for (const auto& o : orthants) {
     if (o.empty()) continue;
+    int first = 0;
+    while (first < num_objectives && is_settled(o.index, first)) ++first;
+    if (first == num_objectives) continue;
     const auto it = seed_rows.find(o.index);
-    seeds.push_back({&o, objectives[0], order, it == seed_rows.end() ? std::vector<int>{} : PositionsOfRows(o, it->second),
-                     max_rounds});
+    seeds.push_back({&o, objectives[first], order,
+                     it == seed_rows.end() ? std::vector<int>{} : PositionsOfRows(o, it->second), max_rounds});
+    seed_objective.push_back(first);
   }
   const auto seed_out = RunRelaxationJobs(ctx, seeds, orthants);
   std::vector<RelaxJob> rest;
   std::vector<int> rest_objective;
   for (std::size_t k = 0; k < seeds.size(); ++k) {
-    out[{seeds[k].orthant->index, 0}] = seed_out[k];
-    for (int j = 1; j < static_cast<int>(objectives.size()); ++j) {
-      rest.push_back({seeds[k].orthant, objectives[j], order, seed_out[k].working_set, max_rounds});
+    out[{seeds[k].orthant->index, seed_objective[k]}] = seed_out[k];
+    for (int j = seed_objective[k] + 1; j < num_objectives; ++j) {
+      if (is_settled(seeds[k].orthant->index, j)) continue;
+      // The seed's active blocks: its working set less the blocks whose multipliers vanish (they only slow the
+      // solves; an objective that needs them gets them back as violated blocks).
+      const auto& start = seed_out[k].active_set.empty() ? seed_out[k].working_set : seed_out[k].active_set;
+      rest.push_back({seeds[k].orthant, objectives[j], order, start, max_rounds});
       rest_objective.push_back(j);
     }
   }
   const auto rest_out = RunRelaxationJobs(ctx, rest, orthants);
   for (std::size_t k = 0; k < rest.size(); ++k) out[{rest[k].orthant->index, rest_objective[k]}] = rest_out[k];
+  for (const auto& [key, r] : settled) out[key] = r;
   return out;
 }
 
@@ -96,7 +109,8 @@ std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<i
 }
 
 CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
-                             const std::vector<Objective>& objectives, std::vector<OrthantWork>& orthants) {
+                             const std::vector<Objective>& objectives, const PassOutcomes& settled,
+                             std::vector<OrthantWork>& orthants) {
   CheapPassResult result;
   std::map<int, std::vector<int>> seed_rows;  // data rows active in the previous pass, per orthant
   for (int pass = 0;; ++pass) {
@@ -104,7 +118,7 @@ CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx
     const std::string phase = contracting ? fmt::format("order {} box contraction {}", options.order, pass + 1)
                                           : fmt::format("order {} relaxations", options.order);
     const int max_rounds = contracting ? std::min(options.contraction_max_rounds, ctx.options.generation.max_rounds) : 0;
-    result.outcomes = RunOnePass(ctx, objectives, orthants, options.order, max_rounds, phase, seed_rows);
+    result.outcomes = RunOnePass(ctx, objectives, settled, orthants, options.order, max_rounds, phase, seed_rows);
     if (!contracting) break;
     for (const auto& [key, r] : result.outcomes) {
       const OrthantWork* o = nullptr;

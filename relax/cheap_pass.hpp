@@ -2,7 +2,7 @@
 // Stage 3 of the bound engine: every objective of every live orthant at the cheap (minimal) order, optionally
 // repeated in contracted boxes (box contraction, BoundsOptions::contraction_passes).
 //
-// Deterministic warm starts: per orthant, the first objective runs first from no blocks (the seed); the other
+// Deterministic warm starts: per orthant, the first objective not settled before runs first from no blocks (the seed); the other
 // objectives start from the blocks the seed found active. Which rows a job starts from therefore never depends
 // on which job finished first, so neither do the numbers.
 #include <map>
@@ -27,8 +27,11 @@ struct CheapPassResult {
   int contraction_passes_run = 0;
 };
 
+// `settled`: objectives already decided per orthant (relax/edge_witness.hpp); they are not solved and their
+// outcomes are returned as given.
 CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
-                             const std::vector<Objective>& objectives, std::vector<OrthantWork>& orthants);
+                             const std::vector<Objective>& objectives, const PassOutcomes& settled,
+                             std::vector<OrthantWork>& orthants);
 
 // Positions in orthant.rows of the given data rows (rows no longer kept are skipped).
 std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<int>& data_rows);

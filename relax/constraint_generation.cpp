@@ -21,6 +21,7 @@ bool ConstraintGenerationOptions::IsValid(std::string* error) const {
   if (max_rounds < 1) return fail("max_rounds must be >= 1");
   if (add_per_round < 1) return fail("add_per_round must be >= 1");
   if (!(violation_tolerance > 0)) return fail("violation_tolerance must be > 0");
+  if (!(active_fraction >= 0 && active_fraction < 1)) return fail("active_fraction must be in [0, 1)");
   if (!verify.IsValid(error)) return false;
   return sdp.IsValid(error);
 }
@@ -88,6 +89,26 @@ std::pair<std::vector<std::pair<double, int>>, double> ViolatedBlocks(const Mome
   }
   std::sort(violated.rbegin(), violated.rend());
   return {violated, worst};
+}
+
+// Candidates of `blocks` whose multiplier block (X) has a trace above `fraction` times the largest among them.
+// The round's problem lists core inequalities first, then the block candidates in `blocks` order.
+std::vector<int> ActiveBlocks(const MomentRelaxation& relaxation, const std::vector<Eigen::MatrixXd>& X,
+                              std::size_t num_core, const std::set<int>& blocks, double fraction) {
+  std::vector<std::pair<int, double>> traces;
+  const auto& block_of = relaxation.block_of_inequality();
+  std::size_t i = num_core;
+  for (int candidate : blocks) {
+    const int b = i < block_of.size() ? block_of[i] : -1;
+    ++i;
+    if (b >= 0 && b < static_cast<int>(X.size())) traces.push_back({candidate, X[b].trace()});
+  }
+  double largest = 0.0;
+  for (const auto& [c, t] : traces) largest = std::max(largest, t);
+  std::vector<int> active;
+  for (const auto& [c, t] : traces)
+    if (t > fraction * largest) active.push_back(c);
+  return active;
 }
 
 }  // namespace
@@ -169,6 +190,7 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
   };
 
   std::vector<double> warm_y;
+  std::set<int> pruned_once;  // blocks returned to scalar rows once; they are kept if they come back
   int failed_in_a_row = 0;
   for (int round = 1; round <= options.max_rounds; ++round) {
     result.rounds = round;
@@ -265,6 +287,10 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     if (solved) {
       warm_y = sdp.y;
       result.last_y = sdp.y;
+      if (sdp.X.size() == relaxation.lmi().blocks.size()) {
+        result.active_set = ActiveBlocks(relaxation, sdp.X, core.inequalities.size(), blocks, options.active_fraction);
+        report.active = static_cast<int>(result.active_set.size());
+      }
     }
     const auto y = relaxation.moments(sdp.y);
     if (solved) result.first_moments.assign(y.begin() + 1, y.begin() + 1 + core.num_vars);
@@ -289,6 +315,17 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
                                        "relaxation's (max relative violation {:.2e})", worst));
     }
     announce(static_cast<int>(violated.size()));
+    if (options.prune_inactive && solved && !result.active_set.empty()) {
+      const std::set<int> active(result.active_set.begin(), result.active_set.end());
+      for (auto it = blocks.begin(); it != blocks.end();) {
+        if (!active.count(*it) && !pruned_once.count(*it)) {
+          pruned_once.insert(*it);
+          it = blocks.erase(it);
+        } else {
+          ++it;
+        }
+      }
+    }
     for (int k = 0; k < std::min<int>(options.add_per_round, violated.size()); ++k) blocks.insert(violated[k].second);
   }
   return result;

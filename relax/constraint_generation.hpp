@@ -27,6 +27,10 @@ struct ConstraintGenerationOptions {
   bool linear_rows_first = true;
   // Pass the previous round's moments to backends that take an initial point (SdpOptions::initial_y).
   bool warm_start = true;
+  double active_fraction = 1e-4;  // see ConstraintGenerationResult::active_set
+  // Between rounds, blocks whose multipliers vanish go back to scalar rows (any subset still gives a valid bound,
+  // and the final check covers every omitted block). A block is pruned at most once, so rounds cannot cycle.
+  bool prune_inactive = true;
   sdp::SdpOptions sdp;
   // Verification (sdp/verified_bound.hpp): every round's multiplier gives a rigorous bound, the final round's
   // with re-solves when needed; an infeasibility certificate that does not verify never declares the set empty.
@@ -43,6 +47,7 @@ struct GenerationRound {
   double bound = NAN;       // the best valid bound so far (NaN: none yet), same sign convention as the result
   bool bound_verified = false;
   int violated = 0;         // omitted blocks violated at this round's moments (-1: not checked)
+  int active = -1;          // blocks whose multiplier is not negligible (-1: no multiplier)
   double seconds = 0.0;
 };
 
@@ -66,6 +71,9 @@ struct ConstraintGenerationResult {
   double max_violation = 0.0;  // largest relative violation among omitted blocks at the last checked round
   int rounds = 0;
   std::vector<int> working_set;  // candidates with a block in the last LMI
+  // The part of the working set whose multipliers are not negligible in the last solved round (trace of the
+  // block's multiplier above active_fraction times the largest): a warm start for other objectives.
+  std::vector<int> active_set;
   std::vector<double> first_moments;
   std::vector<double> last_y;    // the last solved round's LMI variables (a warm start for a next job)
   std::size_t num_moments = 0, num_blocks = 0;

@@ -9,14 +9,20 @@ namespace hw::relax {
 
 PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, const std::vector<Objective>& objectives,
                          const std::vector<int>& wanted_objectives, const PassOutcomes& cheap,
-                         std::vector<OrthantWork>& orthants) {
+                         const PassOutcomes& settled, std::vector<OrthantWork>& orthants) {
   PassOutcomes full;
   std::vector<double> current(objectives.size(), NAN);  // aggregated endpoint of the finished full-order jobs
   std::map<int, std::set<int>> active_rows;              // per orthant: data rows active at full order so far
+  for (const auto& [key, r] : settled) {
+    full[key] = r;
+    const int o = key.second, dir = objectives[o].dir;
+    if (r.status == "solved" && (std::isnan(current[o]) || (dir < 0 ? r.bound < current[o] : r.bound > current[o])))
+      current[o] = r.bound;
+  }
   int total = 0;
   for (int o : wanted_objectives)
     for (const auto& w : orthants)
-      if (!w.empty()) ++total;
+      if (!w.empty() && !settled.count({w.index, o})) ++total;
   ctx.progress.Phase(fmt::format("order {} relaxations", options.order), total);
   while (true) {
     std::vector<RelaxJob> wave;

@@ -324,6 +324,14 @@ std::vector<DataConstraint> HwOuterSet::build(int l, bool scaled) const {
 
 std::vector<DataConstraint> HwOuterSet::data_constraints(int l) const { return build(l, true); }
 
+std::vector<Polynomial> HwOuterSet::orthant_inequalities(int l) const {
+  const auto signs = orthant_signs(l);
+  std::vector<Polynomial> out;
+  for (std::size_t k = 0; k < q_.size(); ++k) out.push_back(q_[k] * signs[k]);
+  for (auto& c : build(l, false)) out.push_back(std::move(c.g));
+  return out;
+}
+
 double HwOuterSet::min_slack(const std::vector<double>& p) const {
   const int l = orthant_of(p);
   double m = INFINITY;

@@ -104,6 +104,9 @@ class HwOuterSet {
   // Evaluates the unscaled model equations' worst-case slack of a parameter point (for tests):
   // min over constraints of the constraint value at p (>= 0 iff p lies in D^ss(n) for its orthant).
   double min_slack(const std::vector<double>& p) const;
+  // Every inequality of orthant l in original variables: the sign constraints sigma_k q_k(p) >= 0, then the
+  // data rows (unscaled, in data_constraints(l)'s order).
+  std::vector<Polynomial> orthant_inequalities(int l) const;
 
  private:
   struct Term {

@@ -135,13 +135,18 @@ bool InnerPointOptions::IsValid(std::string* error) const {
 }
 
 InnerWitness LocalExtreme(const HwOuterSet& set, int l, int k, int dir, const std::vector<double>& start,
-                          const InnerPointOptions& options) {
+                          const InnerPointOptions& options, const std::vector<int>* rows) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("inner point options: " + error);
   const int n = set.num_vars();
   std::vector<FlatPolynomial> cons;
   for (const auto& g : set.sign_constraints(l)) cons.emplace_back(g);
-  for (const auto& c : set.data_constraints(l)) cons.emplace_back(c.g);
+  const auto data = set.data_constraints(l);
+  if (rows) {
+    for (int r : *rows) cons.emplace_back(data.at(r).g);
+  } else {
+    for (const auto& c : data) cons.emplace_back(c.g);
+  }
   std::vector<double> x0(n);
   for (int i = 0; i < n; ++i) x0[i] = (start[i] - set.scaling().center[i]) / set.scaling().radius[i];
   Ipopt::SmartPtr<ExtremeNlp> nlp = new ExtremeNlp(std::move(cons), n, k, dir, x0, options.margin);

@@ -153,10 +153,12 @@ MomentRelaxation::MomentRelaxation(const PolyProblem& problem, int order, const 
     const int k = cap[i] < 0 ? full_k : std::min(cap[i], full_k);
     if (k == 0) {
       scalar.push_back(&g);
+      block_of_inequality_.push_back(-1);
       continue;
     }
     const int size = static_cast<int>(MonomialBasis::count(n, k));
     const int block = static_cast<int>(lmi.blocks.size());
+    block_of_inequality_.push_back(block);
     lmi.blocks.push_back({sdp::BlockSpec::Kind::kPsd, size});
     for (const auto& [e, coef] : g.terms()) {
       const long gi = index_.index_of(e);

@@ -81,9 +81,13 @@ class MomentRelaxation {
   Eigen::MatrixXd localizing_matrix(const Polynomial& g, const std::vector<double>& moments) const;
   // The full localizing order of g in this relaxation: order - ceil(deg g / 2).
   int full_localizing_order(const Polynomial& g) const;
+  // The LMI block of each of the problem's inequalities (box constraints after them); -1 for the scalar ones,
+  // which share the diagonal block.
+  const std::vector<int>& block_of_inequality() const { return block_of_inequality_; }
 
  private:
   int order_;
+  std::vector<int> block_of_inequality_;
   double sign_ = 1.0;
   MomentIndex index_;
   sdp::LmiProblem lmi_;

@@ -10,6 +10,7 @@
 #include "relax/aggregate.hpp"
 #include "relax/bound_jobs.hpp"
 #include "relax/cheap_pass.hpp"
+#include "relax/edge_witness.hpp"
 #include "relax/full_pass.hpp"
 #include "relax/orthant_screen.hpp"
 #include "relax/row_reduction.hpp"
@@ -96,6 +97,7 @@ bool BoundsOptions::IsValid(std::string* error) const {
   if (solver != "csdp" && solver != "sdpa" && solver != "dsdp")
     return fail(fmt::format("solver '{}' unknown; expected csdp, sdpa or dsdp", solver));
   if (!reduction.IsValid(error)) return false;
+  if (!edge_witness.IsValid(error)) return false;
   return generation.IsValid(error);
 }
 
@@ -141,9 +143,11 @@ nlohmann::json BoundsSummary::to_json() const {
   for (const auto& o : orthants) j["orthants"].push_back({{"index", o.index}, {"signs", o.signs}, {"status", o.status}});
   j["counts"] = {{"orthants_total", orthants_total}, {"orthants_proven_empty", orthants_empty},
                  {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
-                 {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache}};
+                 {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache},
+                 {"edge_witness_settled", edge_witness_settled}, {"edge_witness_solves", edge_witness_solves}};
   j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds},
-                 {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds}};
+                 {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds},
+                 {"edge_witness_seconds", edge_witness_seconds}};
   j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
   j["all_guaranteed"] = all_guaranteed();
   j["contraction_passes_run"] = contraction_passes_run;
@@ -222,16 +226,18 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   }
   // 2. Reduce rows.
   ReduceOrthantRows(ctx, orthants);
-  // 3. Cheap pass (with box contraction when asked).
+  // 3. Endpoints at the box edge, settled by feasible points.
+  const EdgeWitnessResult edges = SettleEdgesByWitnesses(options.edge_witness, ctx, objectives, orthants);
+  // 4. Cheap pass (with box contraction when asked).
   CheapPassOptions cheap_options{cheap_order, options.contraction_passes, options.contraction_min_shrink,
                                  options.contraction_max_rounds};
-  const CheapPassResult cheap = RunCheapPass(cheap_options, ctx, objectives, orthants);
-  // 4. Full pass.
+  const CheapPassResult cheap = RunCheapPass(cheap_options, ctx, objectives, edges.settled, orthants);
+  // 5. Full pass.
   PassOutcomes full = cheap.outcomes;
   if (options.order > cheap_order)
     full = RunFullPass(FullPassOptions{options.order, cheap_order}, ctx, objectives, wanted_objectives, cheap.outcomes,
-                       orthants);
-  // 5. Aggregate.
+                       edges.settled, orthants);
+  // 6. Aggregate.
   const AggregateResult agg = AggregateIntervals(
       AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,
       cheap.outcomes, full, orthants);
@@ -263,6 +269,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
     else ++summary.orthants_solved;
     summary.orthants.push_back({l, sign_text(set, l), status[l]});
   }
+  summary.edge_witness_solves = edges.local_solves;
+  summary.edge_witness_seconds = edges.seconds;
+  for (const auto& [key, r] : edges.settled) summary.edge_witness_settled += r.status == "solved" ? 1 : 0;
   summary.sdp_jobs = counters.sdp_jobs;
   summary.sdp_solves = counters.sdp_solves;
   summary.jobs_from_cache = counters.jobs_from_cache;

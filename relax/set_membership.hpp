@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "relax/constraint_generation.hpp"
+#include "relax/edge_witness_options.hpp"
 #include "relax/row_reduction_options.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "sdp/job_executor.hpp"
@@ -58,6 +59,7 @@ struct BoundsOptions {
   int contraction_max_rounds = 4;
   ConstraintGenerationOptions generation;  // its order is set per pass
   RowReductionOptions reduction;           // exact reduction of the data rows (stage 2)
+  EdgeWitnessOptions edge_witness;         // endpoints settled by feasible points at the box edge (stage 3)
   // Progress lines from inside jobs (one per constraint-generation round: working set, status, bound so far).
   // Called in the process that runs the job (a forked worker or an MPI rank); null = silent.
   std::function<void(const std::string&)> round_log;
@@ -101,6 +103,9 @@ struct BoundsSummary {
   int sdp_jobs = 0;           // relaxation jobs run (cached ones excluded)
   int sdp_solves = 0;         // SDP solves including constraint-generation rounds
   int jobs_from_cache = 0;
+  int edge_witness_settled = 0;  // (orthant, objective) pairs settled by a feasible point at the box edge
+  int edge_witness_solves = 0;   // local optimisations run to find them
+  double edge_witness_seconds = 0.0;
   double median_solve_seconds = 0.0;
   double solve_seconds = 0.0, verify_seconds = 0.0;  // totals over the jobs run (cache excluded); verify incl. re-solves
   std::size_t largest_moments = 0, largest_blocks = 0;

@@ -1,0 +1,229 @@
+#include "relax/edge_witness.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <set>
+
+#include <fmt/format.h>
+
+namespace hw::relax {
+
+bool EdgeWitnessOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  if (random_starts < 0) return fail("edge witness: random_starts must be >= 0");
+  if (!(edge_tolerance >= 0 && edge_tolerance < 1e-3)) return fail("edge witness: edge_tolerance must be in [0, 1e-3)");
+  return local.IsValid(error);
+}
+
+namespace {
+
+// g(p) evaluated term by term, and an upper bound of the evaluation's rounding error: each term costs at most
+// deg + 1 roundings, the sum at most T - 1, so |fl(g) - g| <= 2 (T + deg + 2) u sum |terms| (u = 2^-53, the
+// factor 2 covers the second-order terms). At least 1e-12 sum |terms| is allowed, which also covers the rounding
+// between these unscaled rows and the scaled, normalised ones the relaxations use.
+double SlackWithAllowance(const Polynomial& g, const std::vector<double>& p) {
+  double value = 0.0, magnitude = 0.0;
+  int degree = 0;
+  for (const auto& [e, c] : g.terms()) {
+    double t = c;
+    int d = 0;
+    for (std::size_t i = 0; i < e.size(); ++i)
+      for (int k = 0; k < e[i]; ++k) t *= p[i], ++d;
+    value += t;
+    magnitude += std::abs(t);
+    degree = std::max(degree, d);
+  }
+  const double u = std::numeric_limits<double>::epsilon() / 2;
+  const double terms = static_cast<double>(g.terms().size());
+  const double relative = std::max(2.0 * (terms + degree + 2) * u, 1e-12);
+  return value - relative * magnitude;
+}
+
+// Deterministic points in a box (a fixed-seed 64-bit LCG: the same starts on every machine).
+std::vector<std::vector<double>> StartsInBox(const Box& box, int count, int orthant) {
+  std::vector<std::vector<double>> starts;
+  std::vector<double> center;
+  for (const auto& [lo, hi] : box) center.push_back(0.5 * (lo + hi));
+  starts.push_back(center);
+  std::uint64_t state = 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(orthant + 1);
+  for (int s = 0; s < count; ++s) {
+    std::vector<double> p;
+    for (const auto& [lo, hi] : box) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      const double r = static_cast<double>(state >> 11) * 0x1.0p-53;
+      p.push_back(lo + r * (hi - lo));
+    }
+    starts.push_back(std::move(p));
+  }
+  return starts;
+}
+
+JobOutcome SettledAtEdge(double edge, double slack, const std::string& point_text) {
+  JobOutcome r;
+  r.status = "solved";
+  r.bound = r.float_bound = edge;
+  r.tight = true;
+  r.verification = "verified";
+  r.origin = "feasible point at the box edge";
+  r.message = fmt::format("a feasible point attains the prior box edge (certified min slack {:.3g}): {}", slack,
+                          point_text);
+  return r;
+}
+
+JobOutcome SkippedAtEdge(double edge, int orthant) {
+  JobOutcome r;
+  r.status = "skipped";
+  r.bound = r.float_bound = edge;
+  r.tight = true;
+  r.verification = "verified";
+  r.origin = "box edge reached in another orthant";
+  r.message = fmt::format("the interval already reaches the prior box edge (feasible point in orthant {})", orthant);
+  return r;
+}
+
+}  // namespace
+
+double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>& p) {
+  double m = INFINITY;
+  for (const auto& g : set.orthant_inequalities(l)) m = std::min(m, SlackWithAllowance(g, p));
+  return m;
+}
+
+namespace {
+
+std::string WitnessSpec(const OrthantWork& w, const Objective& o, const std::vector<std::vector<double>>& starts) {
+  return nlohmann::json{{"kind", "witness"}, {"l", w.index}, {"param", o.param}, {"dir", o.dir}, {"starts", starts},
+                        {"rows", w.rows}}
+      .dump();
+}
+
+// Runs witness jobs (spec, cache key); answers in job order (an empty object for a job that failed).
+std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector<std::pair<std::string, std::string>>& jobs,
+                                           int* solves) {
+  std::vector<nlohmann::json> answers(jobs.size(), nlohmann::json::object());
+  DispatchJobs(ctx, jobs, [&](std::size_t i, const nlohmann::json& answer, bool) {
+    if (!answer.contains("job_error")) {
+      answers[i] = answer;
+      *solves += answer.value("solves", 0);
+    }
+    ctx.progress.Done();
+  });
+  return answers;
+}
+
+}  // namespace
+
+EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
+                                         const std::vector<Objective>& objectives,
+                                         const std::vector<OrthantWork>& orthants) {
+  EdgeWitnessResult result;
+  if (!options.enabled || objectives.empty()) return result;
+  const auto t0 = std::chrono::steady_clock::now();
+  const HwOuterSet& set = ctx.set;
+  std::vector<const OrthantWork*> live;
+  for (const auto& w : orthants)
+    if (!w.empty()) live.push_back(&w);
+  const int num_objectives = static_cast<int>(objectives.size());
+  ctx.progress.Phase("feasible points at the box edges", static_cast<int>(live.size()) * num_objectives);
+  // Wave 1, one job per orthant: the first objective from deterministic starts in the box finds a feasible
+  // point (or none). Wave 2: every other objective from that point. Each job's starts are fixed before the wave
+  // runs, so the points do not depend on which worker ran what.
+  std::vector<std::pair<std::string, std::string>> first_jobs;
+  for (const auto* w : live) {
+    const auto starts = StartsInBox(w->box, options.random_starts, w->index);
+    const std::string spec = WitnessSpec(*w, objectives[0], starts);
+    first_jobs.push_back({spec, fmt::format("witness_l{}_o0", w->index)});
+  }
+  const auto first = RunWitnessJobs(ctx, first_jobs, &result.local_solves);
+  std::vector<std::pair<std::string, std::string>> rest_jobs;
+  std::vector<ObjectiveKey> rest_keys;
+  std::map<ObjectiveKey, std::vector<double>> found;
+  for (std::size_t i = 0; i < live.size(); ++i) {
+    if (!first[i].value("found", false)) {
+      ctx.progress.Done(num_objectives - 1);  // no point of this orthant found: nothing to start from
+      continue;
+    }
+    const auto p0 = first[i].at("point").get<std::vector<double>>();
+    found[{live[i]->index, 0}] = p0;
+    for (int j = 1; j < num_objectives; ++j) {
+      const std::string spec = WitnessSpec(*live[i], objectives[j], {p0});
+      rest_jobs.push_back({spec, fmt::format("witness_l{}_o{}", live[i]->index, j)});
+      rest_keys.push_back({live[i]->index, j});
+    }
+  }
+  const auto rest = RunWitnessJobs(ctx, rest_jobs, &result.local_solves);
+  for (std::size_t i = 0; i < rest.size(); ++i)
+    if (rest[i].value("found", false)) found[rest_keys[i]] = rest[i].at("point").get<std::vector<double>>();
+  // Wave 3: an objective whose point stopped short of the edge starts again from the feasible point of its
+  // orthant that is most extreme in its parameter (local searches from one start miss far parts of a thin set).
+  std::vector<std::pair<std::string, std::string>> retry_jobs;
+  std::vector<ObjectiveKey> retry_keys;
+  for (const auto& [key, point] : std::map<ObjectiveKey, std::vector<double>>(found)) {
+    const auto [l, j] = key;
+    const OrthantWork* w = nullptr;
+    for (const auto* x : live)
+      if (x->index == l) w = x;
+    const int k = objectives[j].param, dir = objectives[j].dir;
+    const double edge = dir < 0 ? w->box[k].first : w->box[k].second;
+    if (std::abs(point[k] - edge) <= options.edge_tolerance * (w->box[k].second - w->box[k].first)) continue;
+    const std::vector<double>* best = nullptr;
+    for (const auto& [other_key, other] : found)
+      if (other_key.first == l && (dir < 0 ? other[k] < point[k] : other[k] > point[k]) &&
+          (!best || (dir < 0 ? other[k] < (*best)[k] : other[k] > (*best)[k])))
+        best = &other;
+    if (!best) continue;
+    retry_jobs.push_back({WitnessSpec(*w, objectives[j], {*best}), fmt::format("witness_l{}_o{}_retry", l, j)});
+    retry_keys.push_back(key);
+  }
+  if (!retry_jobs.empty())
+    ctx.progress.Phase("feasible points at the box edges (second starts)", static_cast<int>(retry_jobs.size()));
+  const auto retry = RunWitnessJobs(ctx, retry_jobs, &result.local_solves);
+  for (std::size_t i = 0; i < retry.size(); ++i) {
+    if (!retry[i].value("found", false)) continue;
+    const auto p = retry[i].at("point").get<std::vector<double>>();
+    const auto& o = objectives[retry_keys[i].second];
+    auto& current = found[retry_keys[i]];
+    if (o.dir < 0 ? p[o.param] < current[o.param] : p[o.param] > current[o.param]) current = p;
+  }
+
+  // Certification here, whatever the workers said: the point must attain the edge and satisfy every row.
+  std::map<int, int> edge_reached_in;  // objective -> orthant whose point attains the prior box edge
+  for (const auto& [key, point] : found) {
+    const auto [l, j] = key;
+    if (edge_reached_in.count(j)) continue;
+    const OrthantWork* w = nullptr;
+    for (const auto* x : live)
+      if (x->index == l) w = x;
+    const int k = objectives[j].param, dir = objectives[j].dir;
+    const double edge = dir < 0 ? w->box[k].first : w->box[k].second;
+    const double prior = dir < 0 ? set.box()[k].first : set.box()[k].second;
+    const double width = w->box[k].second - w->box[k].first;
+    if (edge != prior || point.size() != static_cast<std::size_t>(set.num_vars()) ||
+        std::abs(point[k] - edge) > options.edge_tolerance * width)
+      continue;
+    std::vector<double> p = point;
+    p[k] = edge;  // onto the edge exactly; the check below is of this point
+    const double slack = CertifiedMinSlack(set, l, p);
+    if (!(slack >= 0)) continue;
+    std::string text;
+    for (std::size_t i = 0; i < p.size(); ++i) text += fmt::format("{}{} = {:.9g}", i ? ", " : "", set.layout().names[i], p[i]);
+    result.settled[key] = SettledAtEdge(edge, slack, text);
+    result.points[key] = p;
+    edge_reached_in[j] = l;
+  }
+  // The other live orthants cannot move an endpoint that is already at the prior box edge.
+  for (const auto& [j, l] : edge_reached_in)
+    for (const auto* w : live)
+      if (w->index != l) result.settled[{w->index, j}] = SkippedAtEdge(objectives[j].dir < 0 ? set.box()[objectives[j].param].first
+                                                                                      : set.box()[objectives[j].param].second,
+                                                                   l);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace hw::relax

@@ -1,0 +1,41 @@
+#pragma once
+// Stage 3 of the bound engine (before any SDP): endpoints that a feasible point settles.
+//
+// When D^ss(n) reaches the prior box's edge in a parameter (a thin set in a wide box does, e.g. the scaling ray
+// of paper 001's example at 31 dB), the relaxation's bound of that objective is the box edge too: the box
+// constraints hold in the relaxation, and a feasible point p of orthant l with p_k at the edge is a feasible
+// point of every relaxation of orthant l. Such a point, found by local optimisation (relax/inner_points.hpp)
+// and checked by evaluating every inequality of the orthant with a rounding-error allowance, settles the
+// objective in that orthant exactly, and the interval's endpoint in every orthant (no orthant can go beyond the
+// box), without an SDP. The settled endpoint is the one the full relaxation would give: nothing is loosened.
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "relax/bound_jobs.hpp"
+#include "relax/edge_witness_options.hpp"
+
+namespace hw::relax {
+
+// Key (orthant, objective index) as in PassOutcomes.
+using ObjectiveKey = std::pair<int, int>;
+
+struct EdgeWitnessResult {
+  // Settled objectives: in the orthant whose point attains the edge ("solved", tight, origin "feasible point at
+  // the box edge"), and in the other live orthants ("skipped": the interval already reaches the box edge).
+  std::map<ObjectiveKey, JobOutcome> settled;
+  std::map<ObjectiveKey, std::vector<double>> points;  // the witness of each settling orthant (original units)
+  int local_solves = 0;
+  double seconds = 0.0;
+};
+
+// The smallest slack of the inequalities of orthant l (sign and data rows, unscaled) at p, each lowered by a
+// bound on its floating-point evaluation error; >= 0 means p lies in D^ss(n) of orthant l despite rounding.
+double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>& p);
+
+EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
+                                         const std::vector<Objective>& objectives,
+                                         const std::vector<OrthantWork>& orthants);
+
+}  // namespace hw::relax

@@ -1,0 +1,18 @@
+#pragma once
+// Options of the edge-witness stage (relax/edge_witness.hpp), apart so that BoundsOptions can hold them.
+#include <string>
+
+#include "relax/inner_points.hpp"
+
+namespace hw::relax {
+
+struct EdgeWitnessOptions {
+  bool enabled = true;
+  int random_starts = 3;  // deterministic starts in the orthant's box when no feasible point is known yet
+  // A witness attains the edge when |p_k - edge| <= edge_tolerance * box width (it is then moved onto it).
+  double edge_tolerance = 1e-8;
+  InnerPointOptions local;
+  bool IsValid(std::string* error) const;
+};
+
+}  // namespace hw::relax

@@ -1,0 +1,78 @@
+// Endpoints settled by feasible points at the prior box edge (relax/edge_witness.hpp): the certified slack
+// accepts points of D^ss(n) and rejects points outside, and a run with the stage gives the endpoints of a run
+// without it (every endpoint by SDP).
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "core/cerone_example.hpp"
+#include "relax/edge_witness.hpp"
+#include "relax/set_membership.hpp"
+
+namespace hw::relax {
+namespace {
+
+HwOuterSet SeededSet(uint64_t seed, int samples, int horizon, double snr_db, double box) {
+  const auto ex = SimulateCeroneExample(seed, samples, snr_db);
+  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  return HwOuterSet(CeroneExampleStructure(), data, horizon, std::vector<std::pair<double, double>>(8, {-box, box}));
+}
+
+TEST(EdgeWitness, CertifiedSlackAcceptsTheTruthAndRejectsAPointOutside) {
+  const HwOuterSet set = SeededSet(5, 60, 2, 31.0, 10.0);
+  const auto truth = CeroneExample::TrueParameters();
+  const int l = set.orthant_of(truth);
+  EXPECT_GE(CertifiedMinSlack(set, l, truth), 0.0);
+  // The allowance only lowers the slack: never above the plain evaluation.
+  EXPECT_LE(CertifiedMinSlack(set, l, truth), set.min_slack(truth));
+  auto far = truth;
+  far[4] = 9.0;  // a1 far from any point that explains the data
+  EXPECT_LT(CertifiedMinSlack(set, set.orthant_of(far), far), 0.0);
+  // A point is checked against the orthant it is claimed for: the truth's sign pattern flipped is outside.
+  EXPECT_LT(CertifiedMinSlack(set, l ^ 1, truth), 0.0);
+}
+
+TEST(EdgeWitness, SettledEndpointsEqualTheRelaxationsAndContainTheTruth) {
+  // Horizon 1 at 31 dB: D^ss(1) reaches the prior box in several parameters, so the stage has work.
+  const HwOuterSet set = SeededSet(7, 40, 1, 31.0, 10.0);
+  BoundsOptions options;
+  options.order = 2;
+  options.threads = 2;
+  options.retry_with_other_solver = false;
+  const BoundsSummary with = ComputeBounds(options, set);
+  options.edge_witness.enabled = false;
+  const BoundsSummary without = ComputeBounds(options, set);
+  ASSERT_GT(with.edge_witness_settled, 0) << "the instance no longer exercises the stage";
+  EXPECT_LT(with.sdp_jobs, without.sdp_jobs);
+  EXPECT_EQ(without.edge_witness_solves, 0);
+  const auto truth = CeroneExample::TrueParameters();
+  ASSERT_EQ(with.intervals.size(), without.intervals.size());
+  for (std::size_t k = 0; k < with.intervals.size(); ++k) {
+    const auto& a = with.intervals[k];
+    const auto& b = without.intervals[k];
+    for (const auto& [x, y, what] : {std::tuple{a.lower, b.lower, "lower"}, std::tuple{a.upper, b.upper, "upper"}}) {
+      EXPECT_EQ(x.status, "guaranteed") << a.name << " " << what;
+      EXPECT_EQ(x.verification, "verified") << a.name << " " << what;
+      // Same endpoint: the box edge that a feasible point attains is the relaxation's bound too.
+      EXPECT_NEAR(x.value, y.value, 1e-6 * (1 + std::abs(y.value))) << a.name << " " << what;
+    }
+    EXPECT_LE(a.lower.value, truth[k]) << a.name;
+    EXPECT_GE(a.upper.value, truth[k]) << a.name;
+  }
+}
+
+TEST(EdgeWitness, OptionsAreChecked) {
+  EdgeWitnessOptions o;
+  std::string error;
+  EXPECT_TRUE(o.IsValid(&error));
+  o.random_starts = -1;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("random_starts"), std::string::npos);
+  o = {};
+  o.edge_tolerance = 0.5;
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
+}  // namespace
+}  // namespace hw::relax
