@@ -336,23 +336,43 @@ sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const Momen
   const int m = relaxation.lmi().num_vars();
   const double inf = std::numeric_limits<double>::infinity();
   sdp::VariableBounds out = sdp::VariableBounds::Uniform(m, -inf, inf);
-  // Premise: 1 - x_i^2 >= 0 (up to a positive factor) for every variable i.
-  std::vector<char> boxed(n, 0);
-  auto check = [&](const Polynomial& g) {
-    if (g.terms().size() != 2) return;
+  // A radius R_i with x_i^2 <= R_i^2 implied by an inequality the relaxation localizes:
+  //   a - sum_j b_j x_j^2 >= 0 (a, b_j > 0; one variable or a ball): R_i^2 = a / b_i, since the localizer's
+  //   diagonal gives sum_j b_j y_{2beta + 2e_j} <= a y_{2beta} and even moments are >= 0;
+  //   (x_i - lo)(hi - x_i) >= 0 (a box): y_{2beta+2e_i} <= |lo + hi| |y_{2beta+e_i}| + |lo hi| y_{2beta} and the
+  //   2x2 minor |y_{2beta+e_i}| <= sqrt(y_{2beta} y_{2beta+2e_i}) give R_i = (c + sqrt(c^2 + 4 |lo hi|)) / 2,
+  //   c = |lo + hi|.
+  // Then |y_alpha| <= prod R_i^alpha_i for every moment of the relaxation (even moments by the chain down to
+  // y_0 = 1, the others by 2x2 minors of the moment matrix).
+  std::vector<double> radius(n, inf);
+  auto take = [&](int i, double r) { radius[i] = std::min(radius[i], r); };
+  for (const auto& g : problem.inequalities) {
     const double a = g.constant_term();
-    if (!(a > 0)) return;
-    for (int i = 0; i < n; ++i) {
-      Exponents e(n, 0);
-      e[i] = 2;
-      if (g.coefficient(e) == -a) boxed[i] = 1;
+    if (!(a > 0) || g.degree() != 2) continue;
+    std::vector<double> b(n, 0.0);
+    bool shape = true;
+    for (const auto& [e, c] : g.terms()) {
+      if (degree_of(e) == 0) continue;
+      int var = -1;
+      for (int i = 0; i < n; ++i)
+        if (e[i] == 2) var = i;
+      if (var < 0 || degree_of(e) != 2 || !(c < 0)) {
+        shape = false;
+        break;
+      }
+      b[var] = -c;
     }
-  };
-  for (const auto& g : problem.inequalities) check(g);
-  if (!problem.box.empty())
+    if (!shape) continue;
     for (int i = 0; i < n; ++i)
-      if (problem.box[i].first == -1.0 && problem.box[i].second == 1.0) boxed[i] = 1;
-  if (std::find(boxed.begin(), boxed.end(), 0) != boxed.end()) return out;
+      if (b[i] > 0) take(i, std::sqrt(a / b[i]));
+  }
+  for (int i = 0; i < static_cast<int>(problem.box.size()) && i < n; ++i) {
+    const auto [lo, hi] = problem.box[i];
+    const double c = std::abs(lo + hi);
+    take(i, 0.5 * (c + std::sqrt(c * c + 4 * std::abs(lo * hi))));
+  }
+  for (double r : radius)
+    if (!std::isfinite(r)) return out;
   // LMI variable z_f is bounded when some moment equals it exactly: y_k = 0 + 1 * z_f (checked on the map
   // itself, through moments(): unit vectors give the columns of y = base + T z exactly).
   const std::vector<double> base = relaxation.moments(std::vector<double>(m, 0.0));
@@ -367,10 +387,16 @@ sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const Momen
       single[k] = (single[k] == -1 && base[k] == 0.0 && y[k] == 1.0) ? f : -2;
     }
   }
+  const auto& monomials = relaxation.index().basis();
   for (std::size_t k = 1; k < single.size(); ++k)
     if (single[k] >= 0) {
-      out.lower[single[k]] = -1.0;
-      out.upper[single[k]] = 1.0;
+      double bound = 1.0;
+      const Exponents& e = monomials[k];
+      for (int i = 0; i < n; ++i) bound *= std::pow(radius[i], e[i]);
+      // Rounding of the product: one ulp per factor is far below this allowance.
+      bound *= 1.0 + 1e-12;
+      out.lower[single[k]] = -bound;
+      out.upper[single[k]] = bound;
     }
   return out;
 }

@@ -94,10 +94,10 @@ ConstraintGenerationResult SolveWithConstraintGeneration(
     const std::function<void(const GenerationRound&)>& on_round = {}, sdp::SdpSolver* fallback = nullptr);
 
 // A-priori bounds of the LMI variables of a moment relaxation, valid for every feasible point of its LMI.
-// When the problem contains a positive multiple of 1 - x_i^2 >= 0 for every variable (or the box [-1, 1]^n),
-// every moment up to degree 2 delta satisfies |y_alpha| <= 1 (the localizers give y_{2 gamma} <= y_{2 beta}
-// <= ... <= y_0 = 1, and 2x2 minors of the moment matrix bound the rest); an LMI variable that equals a moment
-// inherits [-1, 1]. Everything else is unbounded (+-infinity).
+// When every variable has a radius R_i implied by a localized inequality (a - b x_i^2 >= 0, a ball
+// a - sum b_j x_j^2 >= 0, or a box lo <= x_i <= hi), every moment up to degree 2 delta satisfies
+// |y_alpha| <= prod R_i^alpha_i (for the scaled box [-1, 1]^n: |y_alpha| <= 1); an LMI variable that equals a
+// moment inherits that bound. Everything else is unbounded (+-infinity).
 sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const MomentRelaxation& relaxation);
 
 }  // namespace hw::relax

@@ -1,5 +1,8 @@
 #include "relax/moment_relaxation.hpp"
 
+#include "relax/constraint_generation.hpp"
+#include "sdp/verified_bound.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -411,10 +414,21 @@ RelaxationResult SolveRelaxation(const RelaxationOptions& options, const PolyPro
   const double sign = relaxation->objective_sign();
   switch (sdp.status) {
     case sdp::SdpStatus::kOptimal: break;
-    case sdp::SdpStatus::kInfeasible:
-      result.status = RelaxationStatus::kInfeasible;
-      result.message = "the relaxation is infeasible, so the problem is infeasible";
+    case sdp::SdpStatus::kInfeasible: {
+      // The backend's certificate test holds for moments up to 1 / infeasibility_tolerance; a rigorous
+      // emptiness claim needs the a-priori moment bounds that the problem implies (a box or a ball).
+      const auto cert = sdp::VerifyInfeasibility(relaxation->lmi(), sdp.X, MomentVariableBounds(problem, *relaxation));
+      if (cert.verified()) {
+        result.status = RelaxationStatus::kInfeasible;
+        result.message = "the relaxation is infeasible (certificate verified), so the problem is infeasible";
+      } else {
+        result.status = RelaxationStatus::kSolverFailed;
+        result.message = fmt::format("{} reports the relaxation infeasible, but the certificate does not verify "
+                                     "({}); the problem is NOT declared infeasible (a box or a ball bounds the moments)",
+                                     sdp.solver, cert.message);
+      }
       return result;
+    }
     case sdp::SdpStatus::kUnbounded:
       result.status = RelaxationStatus::kUnbounded;
       result.message = "the relaxation is unbounded (add a box or a ball to make the feasible set compact)";

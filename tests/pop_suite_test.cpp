@@ -189,6 +189,26 @@ TEST(PopSuite, MotzkinWithoutConstraintsHasNoSosBound) {
   EXPECT_FALSE(r.flat);
 }
 
+TEST(PopSuite, FeasibleProblemWithUnboundedMomentsIsNeverReportedInfeasible) {
+  // min x1 s.t. x1 >= 4 (x2, x3 free): feasible. At high orders the moments grow like 4^(2 delta), beyond the
+  // range where a backend's approximate infeasibility certificate means anything; without a box or a ball that
+  // bounds the moments, no emptiness claim can be verified, so none is made.
+  PolyProblem p;
+  p.num_vars = 3;
+  p.objective = parse_polynomial("x1", {"x1", "x2", "x3"});
+  p.inequalities = {parse_polynomial("x1 - 4", {"x1", "x2", "x3"})};
+  for (const std::string name : {"csdp", "sdpa"}) {
+    auto solver = sdp::MakeSolver(name);
+    for (int order : {6, 8}) {
+      RelaxationOptions opt;
+      opt.order = order;
+      const auto r = SolveRelaxation(opt, p, *solver);
+      EXPECT_NE(r.status, RelaxationStatus::kInfeasible) << name << " order " << order << ": " << r.message;
+      if (r.status == RelaxationStatus::kSolved) EXPECT_LE(r.bound, 4.0 + 1e-4) << name << " order " << order;
+    }
+  }
+}
+
 TEST(PopSuite, InfeasibleProblemIsReportedInfeasible) {
   PolyProblem p;
   p.num_vars = 2;
