@@ -32,8 +32,7 @@ void Run(const Opts& p, bool t_named, bool valid_t_named) {
   diagnose::ColumnNames ic = p.ident_cols, vc = p.valid_cols;
   ic.t_required = t_named;
   vc.t_required = valid_t_named;
-  const auto ident = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.data, ic));
-  const auto valid = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.validate, vc));
+  // Every input is checked before any work: the model or fit spec, then the recordings.
   diagnose::AugmentedModel nominal;
   std::unique_ptr<diagnose::NominalSpec> spec;
   if (!p.model.empty()) {
@@ -43,6 +42,10 @@ void Run(const Opts& p, bool t_named, bool valid_t_named) {
                                    p.model, nominal.Label()));
   } else {
     spec = std::make_unique<diagnose::NominalSpec>(diagnose::NominalSpec::Parse(p.fit));
+  }
+  const auto ident = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.data, ic));
+  const auto valid = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.validate, vc));
+  if (spec) {
     const diagnose::NominalFit fit =
         diagnose::FitNominal(*spec, {&ident.u, &ident.y, o.init_samples, 0}, o.nominal_fit);
     fmt::print("{}\n", fit.Summary());

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -101,6 +102,8 @@ std::vector<double> ToDoubles(const matvar_t& v) {
 class MatFile {
  public:
   explicit MatFile(const std::string& path) : path_(path) {
+    if (std::filesystem::is_directory(path))
+      throw InputError(fmt::format("{}: is a directory; expected a MATLAB .mat file", path));
     if (!std::ifstream(path)) throw InputError(fmt::format("{}: cannot open file", path));
     InstallMatioLog();
     matio_last_message.clear();

@@ -283,9 +283,9 @@ void Summarise(DiagnoseReport* rp) {
                 param_note;
   else
     r.message = fmt::format(
-        "verdict: {} ({}). Where: {} window(s), {:.1f} % of the identification samples, {}. Validation RMSE {:.4g} "
+        "verdict: {}. Where: {} window(s), {:.1f} % of the identification samples, {}. Validation RMSE {:.4g} "
         "-> {:.4g} (fit {:.1f} % -> {:.1f} %).",
-        r.augmented_model.Label(), ParamText(r.augmented_model), r.windows.size(), 100 * frac, r.region.description,
+        ParamText(r.augmented_model), r.windows.size(), 100 * frac, r.region.description,
         r.nominal_refit.rmse, r.augmented.rmse, r.nominal_refit.fit_percent, r.augmented.fit_percent) +
         per_block + param_note;
 }

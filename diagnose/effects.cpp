@@ -1,5 +1,7 @@
 #include "diagnose/effects.hpp"
 
+#include "core/json_input.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -516,14 +518,7 @@ AugmentedModel AugmentedModel::from_json(const nlohmann::json& j) {
 }
 
 AugmentedModel AugmentedModel::Load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open model file", path));
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
-  }
+  const nlohmann::json j = ReadJsonFile(path, "model JSON file");  // names the file: missing, a directory, bad JSON
   try {
     return from_json(j);
   } catch (const InputError& e) {

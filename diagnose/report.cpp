@@ -171,7 +171,8 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
 
 std::string ReportMarkdown(const DiagnoseReport& r, const Recording& ident, const Recording& valid) {
   std::string s = "# Discrepancy diagnosis\n\n";
-  s += fmt::format("**Verdict: {}.** {}\n\n", Verdict(r), r.message.substr(r.message.find(' ') + 1));
+  // The message starts with "verdict: " and names the blocks with their parameters once.
+  s += fmt::format("**Verdict:** {}\n\n", r.message.substr(r.message.find(' ') + 1));
   s += fmt::format("Identification: `{}` ({} samples); validation: `{}` ({} samples). Run time {:.2f} s.\n\n",
                    ident.name, ident.y.size(), valid.name, valid.y.size(), r.seconds);
   s += "## Where the nominal model differs\n\n";

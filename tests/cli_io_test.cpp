@@ -164,6 +164,15 @@ TEST_F(CliIo, DirectoryAsInputFileIsNamed) {
   EXPECT_TRUE(Has(r.output, Path("recdir") + ": is a directory")) << r.output;
   const auto m = Cli("simulate --model " + Path("recdir") + " --input " + Path("rec.csv") + " --out " + Path("o.csv"));
   EXPECT_TRUE(Has(m.output, "is a directory")) << m.output;
+  // The diagnosis's model reader and the .mat reader name the directory too.
+  const auto d = Cli("diagnose --data " + Path("rec.csv") + " --validate " + Path("rec.csv") + " --model " +
+                     Path("recdir") + " --out " + Path("diag_out"));
+  EXPECT_EQ(d.code, 2) << d.output;
+  EXPECT_TRUE(Has(d.output, Path("recdir") + ": is a directory")) << d.output;
+  fs::create_directories(Path("matdir.mat"));
+  const auto mat = Cli("bounds --data " + Path("matdir.mat") + ":u=u,y=y --noise-bound 0.1 --quiet");
+  EXPECT_EQ(mat.code, 2) << mat.output;
+  EXPECT_TRUE(Has(mat.output, Path("matdir.mat") + ": is a directory")) << mat.output;
 }
 
 TEST_F(CliIo, NegativeNoiseBoundNamesTheFileLine) {

@@ -345,6 +345,18 @@ TEST(Report, WritesJsonMarkdownAndSchemaKeys) {
     for (const char* k : {"effect", "location", "parameters", "blocks", "evidence", "score", "eligible"})
       EXPECT_TRUE(f.contains(k)) << k;
   EXPECT_TRUE(std::filesystem::exists(dir + "/report.md"));
+  // A person reads the verdict once: the block is named once, with its parameters, and no share exceeds 100 %.
+  std::ifstream md_in(dir + "/report.md");
+  const std::string md((std::istreambuf_iterator<char>(md_in)), std::istreambuf_iterator<char>());
+  const std::string verdict_line = md.substr(md.find("**Verdict:**"), md.find('\n', md.find("**Verdict:**")) - md.find("**Verdict:**"));
+  ASSERT_NE(r.verdict, Effect::kNone) << r.message;  // the hidden saturation is found
+  {
+    const std::string label = r.augmented_model.Label();
+    std::size_t count = 0;
+    for (std::size_t pos = verdict_line.find(label); pos != std::string::npos; pos = verdict_line.find(label, pos + 1)) ++count;
+    EXPECT_EQ(count, 1u) << verdict_line;
+  }
+  EXPECT_EQ(verdict_line.find("verdict:"), std::string::npos) << verdict_line;
   // The augmented model written beside the report reads back.
   EXPECT_NO_THROW(AugmentedModel::Load(dir + "/augmented_model.json"));
   std::filesystem::remove_all(dir);
