@@ -343,7 +343,8 @@ void AddBoundsCommand(CLI::App& app) {
       static double last_line = -1e9;
       if (p.done > 0 && p.done < p.total && p.elapsed_seconds - last_line < 5.0) return;
       last_line = p.elapsed_seconds;
-      fmt::print(stderr, "[{}] {}/{} jobs, elapsed {:.0f} s, ETA {:.0f} s\n", p.phase, p.done, p.total,
+      fmt::print(stderr, "[{}] {}/{} jobs{}, elapsed {:.0f} s, ETA {:.0f} s\n", p.phase, p.done, p.total,
+                 p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
                  p.elapsed_seconds, p.eta_seconds);
     };
     const auto summary = relax::ComputeBounds(options, set, progress);

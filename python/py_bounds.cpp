@@ -65,6 +65,7 @@ py::dict ProgressDict(const relax::BoundsProgress& p) {
   d["total"] = p.total;
   d["elapsed_seconds"] = p.elapsed_seconds;
   d["eta_seconds"] = p.eta_seconds;
+  d["from_cache"] = p.from_cache;
   return d;
 }
 
@@ -158,7 +159,8 @@ void DefineBounds(py::module_& m) {
 `hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
 Options mirror relax::HwStructure and relax::BoundsOptions (same names, defaults and validation messages).
 box: None (every parameter in [-10, 10]), (lo, hi), {name: (lo, hi)} or one pair per parameter.
-progress: called as progress(dict(phase, done, total, elapsed_seconds, eta_seconds)) after each job.
+progress: called as progress(dict(phase, done, total, from_cache, elapsed_seconds, eta_seconds)) after each job
+(done/total count the jobs still to run; from_cache those read from run_dir).
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
 its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",

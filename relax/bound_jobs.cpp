@@ -103,19 +103,32 @@ void ProgressReporter::Phase(const std::string& name, int total) {
   phase_ = name;
   done_ = 0;
   total_ = total;
+  from_cache_ = uncounted_ = 0;
   phase_start_ = now_seconds();
-  if (sink_ && total > 0) sink_({phase_, 0, total_, 0.0, 0.0});
+  if (sink_ && total > 0) sink_({phase_, 0, total_, 0, 0.0, 0.0});
+}
+
+void ProgressReporter::FromCache(int jobs) {
+  if (jobs <= 0) return;
+  total_ = std::max(0, total_ - jobs);
+  from_cache_ += jobs;
+  uncounted_ += jobs;
+  if (sink_) sink_({phase_, done_, total_, from_cache_, now_seconds() - phase_start_, 0.0});
 }
 
 void ProgressReporter::Done(int jobs) {
+  const int skip = std::min(jobs, uncounted_);
+  uncounted_ -= skip;
+  jobs -= skip;
+  if (jobs <= 0) return;
   done_ += jobs;
   if (!sink_) return;
   const double el = now_seconds() - phase_start_;
-  sink_({phase_, done_, total_, el, done_ > 0 ? el / done_ * (total_ - done_) : 0.0});
+  sink_({phase_, done_, total_, from_cache_, el, done_ > 0 ? el / done_ * (total_ - done_) : 0.0});
 }
 
 void ProgressReporter::Message(const std::string& text) {
-  if (sink_) sink_({text, -1, -1, 0.0, 0.0});
+  if (sink_) sink_({text, -1, -1, 0, 0.0, 0.0});
 }
 
 std::string BoxHash(const Box& box) {
@@ -272,15 +285,18 @@ void DispatchJobs(EngineContext& ctx, const std::vector<std::pair<std::string, s
                   const std::function<void(std::size_t, const nlohmann::json&, bool)>& on_done) {
   std::vector<std::string> specs;
   std::vector<std::size_t> spec_job;
+  std::vector<std::pair<std::size_t, nlohmann::json>> cached;
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     if (auto j = ctx.cache.load(jobs[i].second)) {
-      ++ctx.counters.jobs_from_cache;
-      on_done(i, *j, true);
+      cached.push_back({i, std::move(*j)});
       continue;
     }
     specs.push_back(jobs[i].first);
     spec_job.push_back(i);
   }
+  ctx.counters.jobs_from_cache += static_cast<int>(cached.size());
+  ctx.progress.FromCache(static_cast<int>(cached.size()));
+  for (const auto& [i, j] : cached) on_done(i, j, true);
   ctx.executor.Map(specs, ctx.job, [&](std::size_t s, const sdp::JobResult& r) {
     const std::size_t i = spec_job[s];
     if (!r.ok) {  // a crashed or throwing job: reported by the caller, never dropped, not cached

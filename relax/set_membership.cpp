@@ -210,7 +210,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   EngineCounters counters;
   ProgressReporter reporter(progress);
   if (const int stored = cache.stored_jobs(); stored > 0)
-    reporter.Message(fmt::format("resuming: {} finished jobs from {}", stored, cache.path()));
+    reporter.Message(fmt::format("resuming: {} finished jobs from {}; each phase counts only the jobs still to run",
+                                 stored, cache.path()));
   EngineContext ctx{options, set, *executor, job, cache, counters, reporter};
 
   // 1. Screen orthants.

@@ -92,7 +92,8 @@ struct OrthantReport {
 
 struct BoundsProgress {
   std::string phase;   // with done = total = -1: a one-off message (e.g. "resuming: ...")
-  int done = 0, total = 0;
+  int done = 0, total = 0;  // of the jobs still to run in this phase (jobs read from the run cache excluded)
+  int from_cache = 0;       // jobs of this phase read from the run cache so far
   double elapsed_seconds = 0.0, eta_seconds = 0.0;
 };
 

@@ -78,7 +78,7 @@ def test_progress_reports_every_job(recording):
     seen = []
     result = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, parameters=["a1"],
                              solver="csdp", threads=2, progress=seen.append, box=(-5, 5))
-    assert seen and set(seen[0]) == {"phase", "done", "total", "elapsed_seconds", "eta_seconds"}
+    assert seen and set(seen[0]) == {"phase", "done", "total", "from_cache", "elapsed_seconds", "eta_seconds"}
     assert seen[-1]["done"] == seen[-1]["total"]
     assert all(b["lo"] == -5 and b["hi"] == 5 for b in result["prior_box"])
 
