@@ -346,9 +346,16 @@ sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const Momen
   // y_0 = 1, the others by 2x2 minors of the moment matrix).
   std::vector<double> radius(n, inf);
   auto take = [&](int i, double r) { radius[i] = std::min(radius[i], r); };
-  for (const auto& g : problem.inequalities) {
+  // Only inequalities with their full localizing matrix count: the chain needs its diagonal up to x^(2 beta),
+  // |beta| = delta - 1 (a scalar row L_y(g) >= 0 bounds the second moments alone).
+  const auto& block_of = relaxation.block_of_inequality();
+  const int full_size = static_cast<int>(MonomialBasis::count(n, relaxation.order() - 1));
+  for (std::size_t gi = 0; gi < problem.inequalities.size(); ++gi) {
+    const Polynomial& g = problem.inequalities[gi];
     const double a = g.constant_term();
     if (!(a > 0) || g.degree() != 2) continue;
+    const int localized = gi >= block_of.size() ? -1 : block_of[gi] < 0 ? 1 : relaxation.lmi().blocks[block_of[gi]].size;
+    if (localized < full_size) continue;  // a scalar row (size 1) suffices at order 1 only
     std::vector<double> b(n, 0.0);
     bool shape = true;
     for (const auto& [e, c] : g.terms()) {
@@ -393,8 +400,8 @@ sdp::VariableBounds MomentVariableBounds(const PolyProblem& problem, const Momen
       double bound = 1.0;
       const Exponents& e = monomials[k];
       for (int i = 0; i < n; ++i) bound *= std::pow(radius[i], e[i]);
-      // Rounding of the product: one ulp per factor is far below this allowance.
-      bound *= 1.0 + 1e-12;
+      // Rounding of the product (radii other than 1): one ulp per factor is far below this allowance.
+      if (bound != 1.0) bound *= 1.0 + 1e-12;
       out.lower[single[k]] = -bound;
       out.upper[single[k]] = bound;
     }

@@ -89,16 +89,28 @@ Solved Solve(const MomentRelaxation& r, const PolyProblem& p, const std::string&
 }
 
 TEST(VerifiedBound, MomentBoundsNeedTheBoxLocalizers) {
+  // Box [-1, 1]^2 alone: |y_alpha| <= 1 exactly.
+  PolyProblem box = Disc(false, 0.5);
+  box.inequalities.pop_back();
+  MomentRelaxation rb(box, 2);
+  const auto bb = relax::MomentVariableBounds(box, rb);
+  ASSERT_EQ(static_cast<int>(bb.lower.size()), rb.lmi().num_vars());
+  for (int i = 0; i < rb.lmi().num_vars(); ++i) {
+    EXPECT_EQ(bb.lower[i], -1.0);
+    EXPECT_EQ(bb.upper[i], 1.0);
+  }
+  // With the disc x1^2 + x2^2 <= 0.5 too, the radius sqrt(0.5) bounds every moment more tightly.
   const auto p = Disc(false, 0.5);
   MomentRelaxation r(p, 2);
   const auto b = relax::MomentVariableBounds(p, r);
-  ASSERT_EQ(static_cast<int>(b.lower.size()), r.lmi().num_vars());
   for (int i = 0; i < r.lmi().num_vars(); ++i) {
-    EXPECT_EQ(b.lower[i], -1.0);
-    EXPECT_EQ(b.upper[i], 1.0);
+    EXPECT_LE(b.upper[i], std::sqrt(0.5) * (1 + 1e-9));
+    EXPECT_GE(b.upper[i], 0.25);  // degree <= 4: at least sqrt(0.5)^4
+    EXPECT_EQ(b.lower[i], -b.upper[i]);
   }
+  // x1 bounded by nothing: every bound is infinite.
   PolyProblem q = p;
-  q.inequalities.erase(q.inequalities.begin());  // x1 has no 1 - x1^2 >= 0
+  q.inequalities = {p.inequalities[1]};  // only 1 - x2^2 >= 0
   MomentRelaxation rq(q, 2);
   const auto bq = relax::MomentVariableBounds(q, rq);
   for (int i = 0; i < rq.lmi().num_vars(); ++i) EXPECT_TRUE(std::isinf(bq.upper[i]));
