@@ -16,6 +16,7 @@ bool EdgeWitnessOptions::IsValid(std::string* error) const {
     return false;
   };
   if (random_starts < 0) return fail("edge witness: random_starts must be >= 0");
+  if (min_order < 1) return fail("edge witness: min_order must be >= 1");
   if (!(edge_tolerance >= 0 && edge_tolerance < 1e-3)) return fail("edge witness: edge_tolerance must be in [0, 1e-3)");
   return local.IsValid(error);
 }

@@ -8,6 +8,9 @@ namespace hw::relax {
 
 struct EdgeWitnessOptions {
   bool enabled = true;
+  // Below this relaxation order the SDP jobs cost milliseconds (order 1 gives the box edges for these
+  // problems), far less than the local searches; the stage then does not run.
+  int min_order = 2;
   int random_starts = 3;  // deterministic starts in the orthant's box when no feasible point is known yet
   // A witness attains the edge when |p_k - edge| <= edge_tolerance * box width (it is then moved onto it).
   double edge_tolerance = 1e-8;

@@ -228,7 +228,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   // 2. Reduce rows.
   ReduceOrthantRows(ctx, orthants);
   // 3. Endpoints at the box edge, settled by feasible points.
-  const EdgeWitnessResult edges = SettleEdgesByWitnesses(options.edge_witness, ctx, objectives, orthants);
+  EdgeWitnessOptions edge_options = options.edge_witness;
+  edge_options.enabled = edge_options.enabled && options.order >= edge_options.min_order;
+  const EdgeWitnessResult edges = SettleEdgesByWitnesses(edge_options, ctx, objectives, orthants);
   // 4. Cheap pass (with box contraction when asked).
   CheapPassOptions cheap_options{cheap_order, options.contraction_passes, options.contraction_min_shrink,
                                  options.contraction_max_rounds};
