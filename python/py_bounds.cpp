@@ -123,7 +123,7 @@ void DefineBounds(py::module_& m) {
   m.def(
       "bounds",
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
-         std::string output_basis, int horizon, int order, bool strictly_proper, py::handle box, std::string solver,
+         std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
          bool edge_witnesses, bool lp_screen, bool retry_with_other_solver, int contraction_passes, double contraction_min_shrink,
          int contraction_max_rounds, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
@@ -137,7 +137,8 @@ void DefineBounds(py::module_& m) {
         a.horizon = horizon;
         a.executor = std::move(executor);
         auto& op = a.options;
-        op.order = order;
+        // None = the minimal order ceil((n + 1) / 2) (at least 1), as the CLI's default "--order minimal".
+        op.order = order.is_none() ? std::max(1, (horizon + 2) / 2) : order.cast<int>();
         op.solver = std::move(solver);
         op.threads = threads;
         op.run_dir = std::move(run_dir);
@@ -166,7 +167,7 @@ counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the 
 its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
       py::arg("input_basis") = "poly:3", py::arg("output_basis") = "poly:3", py::arg("horizon") = 2,
-      py::arg("order") = o.order, py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
+      py::arg("order") = py::none(), py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
       py::arg("box") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
       py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
       py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,

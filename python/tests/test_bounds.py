@@ -26,6 +26,17 @@ def recording(tmp_path):
     return str(path), {"u": data[:, 1], "y": data[:, 3], "noise_bound": data[:, 4]}
 
 
+def test_default_order_is_the_minimal_order_as_in_the_cli(recording, tmp_path):
+    path, rec = recording
+    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--params", "a1",
+            "--solver", "csdp", "--threads", 2, "--quiet", "--json", tmp_path / "cli.json")
+    cli = load_json(tmp_path / "cli.json")
+    py = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, parameters=["a1"], solver="csdp",
+                         threads=2, source=path)
+    assert py["order"] == cli["order"] == 1
+    assert without(py, "timing") == without(cli, "timing")
+
+
 def test_same_result_as_the_cli(recording, tmp_path):
     path, rec = recording
     run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--params", "a1,b1",
