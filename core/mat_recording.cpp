@@ -81,7 +81,7 @@ std::vector<double> Convert(const void* data, std::size_t n) {
   return std::vector<double>(p, p + n);
 }
 
-std::vector<double> ToDoubles(const matvar_t& v) {
+std::vector<double> AsDoubleSamples(const matvar_t& v) {
   const std::size_t n = Elements(v);
   switch (v.class_type) {
     case MAT_C_DOUBLE: return Convert<double>(v.data, n);
@@ -143,7 +143,7 @@ class MatFile {
     VarPtr var(Mat_VarRead(mat_, name.c_str()));
     if (!var || !var->data)
       throw InputError(fmt::format("{}: variable '{}' could not be read{}", path_, name, MatioDetail()));
-    auto values = ToDoubles(*var);
+    auto values = AsDoubleSamples(*var);
     for (std::size_t i = 0; i < values.size(); ++i)
       if (!std::isfinite(values[i]))
         throw InputError(fmt::format("{}: variable '{}' sample {} is {}; every sample must be a finite number", path_,

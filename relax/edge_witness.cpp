@@ -64,28 +64,21 @@ std::vector<std::vector<double>> StartsInBox(const Box& box, int count, int orth
   return starts;
 }
 
-JobOutcome SettledAtEdge(double edge, double slack, const std::string& point_text) {
+// An outcome at the box edge: exact and verified by a feasible point (in this orthant, or in another one for a
+// "skipped" objective that cannot move the endpoint).
+JobOutcome AtEdge(const std::string& status, double edge, const std::string& origin, std::string message) {
   JobOutcome r;
-  r.status = "solved";
+  r.status = status;
   r.bound = r.float_bound = edge;
   r.tight = true;
   r.verification = "verified";
-  r.origin = "feasible point at the box edge";
-  r.message = fmt::format("a feasible point attains the prior box edge (certified min slack {:.3g}): {}", slack,
-                          point_text);
+  r.origin = origin;
+  r.message = std::move(message);
   return r;
 }
 
-JobOutcome SkippedAtEdge(double edge, int orthant) {
-  JobOutcome r;
-  r.status = "skipped";
-  r.bound = r.float_bound = edge;
-  r.tight = true;
-  r.verification = "verified";
-  r.origin = "box edge reached in another orthant";
-  r.message = fmt::format("the interval already reaches the prior box edge (feasible point in orthant {})", orthant);
-  return r;
-}
+// The side of `box` an objective runs toward.
+double EdgeOf(const Box& box, const Objective& o) { return o.dir < 0 ? box[o.param].first : box[o.param].second; }
 
 }  // namespace
 
@@ -127,8 +120,9 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
   const auto t0 = std::chrono::steady_clock::now();
   const HwOuterSet& set = ctx.set;
   std::vector<const OrthantWork*> live;
+  std::map<int, const OrthantWork*> by_index;
   for (const auto& w : orthants)
-    if (!w.empty()) live.push_back(&w);
+    if (!w.empty()) live.push_back(&w), by_index[w.index] = &w;
   const int num_objectives = static_cast<int>(objectives.size());
   ctx.progress.Phase("feasible points at the box edges", static_cast<int>(live.size()) * num_objectives);
   // Wave 1, one job per orthant: the first objective from deterministic starts in the box finds a feasible
@@ -166,11 +160,9 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
   std::vector<ObjectiveKey> retry_keys;
   for (const auto& [key, point] : std::map<ObjectiveKey, std::vector<double>>(found)) {
     const auto [l, j] = key;
-    const OrthantWork* w = nullptr;
-    for (const auto* x : live)
-      if (x->index == l) w = x;
+    const OrthantWork* w = by_index.at(l);
     const int k = objectives[j].param, dir = objectives[j].dir;
-    const double edge = dir < 0 ? w->box[k].first : w->box[k].second;
+    const double edge = EdgeOf(w->box, objectives[j]);
     if (std::abs(point[k] - edge) <= options.edge_tolerance * (w->box[k].second - w->box[k].first)) continue;
     const std::vector<double>* best = nullptr;
     for (const auto& [other_key, other] : found)
@@ -197,12 +189,10 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
   for (const auto& [key, point] : found) {
     const auto [l, j] = key;
     if (edge_reached_in.count(j)) continue;
-    const OrthantWork* w = nullptr;
-    for (const auto* x : live)
-      if (x->index == l) w = x;
-    const int k = objectives[j].param, dir = objectives[j].dir;
-    const double edge = dir < 0 ? w->box[k].first : w->box[k].second;
-    const double prior = dir < 0 ? set.box()[k].first : set.box()[k].second;
+    const OrthantWork* w = by_index.at(l);
+    const int k = objectives[j].param;
+    const double edge = EdgeOf(w->box, objectives[j]);
+    const double prior = EdgeOf(set.box(), objectives[j]);
     const double width = w->box[k].second - w->box[k].first;
     if (edge != prior || point.size() != static_cast<std::size_t>(set.num_vars()) ||
         std::abs(point[k] - edge) > options.edge_tolerance * width)
@@ -213,16 +203,19 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
     if (!(slack >= 0)) continue;
     std::string text;
     for (std::size_t i = 0; i < p.size(); ++i) text += fmt::format("{}{} = {:.9g}", i ? ", " : "", set.layout().names[i], p[i]);
-    result.settled[key] = SettledAtEdge(edge, slack, text);
+    result.settled[key] = AtEdge("solved", edge, "feasible point at the box edge",
+                                 fmt::format("a feasible point attains the prior box edge (certified min slack "
+                                             "{:.3g}): {}", slack, text));
     result.points[key] = p;
     edge_reached_in[j] = l;
   }
   // The other live orthants cannot move an endpoint that is already at the prior box edge.
   for (const auto& [j, l] : edge_reached_in)
     for (const auto* w : live)
-      if (w->index != l) result.settled[{w->index, j}] = SkippedAtEdge(objectives[j].dir < 0 ? set.box()[objectives[j].param].first
-                                                                                      : set.box()[objectives[j].param].second,
-                                                                   l);
+      if (w->index != l)
+        result.settled[{w->index, j}] =
+            AtEdge("skipped", EdgeOf(set.box(), objectives[j]), "box edge reached in another orthant",
+                   fmt::format("the interval already reaches the prior box edge (feasible point in orthant {})", l));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }
