@@ -14,13 +14,13 @@ namespace {
 
 // Refuses, with the numbers, a relaxation whose estimated memory exceeds what the machine has now; says the
 // size of a large one that fits before building it.
-void CheckRelaxationFits(const relax::PolyProblem& problem, int order) {
-  const auto size = relax::EstimateRelaxationSize(problem, order);
+void CheckRelaxationFits(const relax::PolyProblem& problem, int order, const std::string& solver) {
+  const auto size = relax::EstimateRelaxationSize(problem, order, solver);
   const double available = relax::AvailableMemoryBytes();
   if (size.bytes > available) {
     int fits = order;
-    while (fits > problem.minimal_order() && relax::EstimateRelaxationSize(problem, fits).bytes > available) --fits;
-    const auto largest = relax::EstimateRelaxationSize(problem, fits);
+    while (fits > problem.minimal_order() && relax::EstimateRelaxationSize(problem, fits, solver).bytes > available) --fits;
+    const auto largest = relax::EstimateRelaxationSize(problem, fits, solver);
     throw InputError(fmt::format(
         "--order {}: the relaxation of this {}-variable problem is too large: {}, more than the {} of memory available; "
         "{}",
@@ -55,7 +55,7 @@ void AddPopCommand(CLI::App& app) {
     relax::RelaxationOptions options;
     options.order = o->order;
     relax::CheckRelaxationOrder(problem, o->order);
-    CheckRelaxationFits(problem, o->order > 0 ? o->order : problem.minimal_order());
+    CheckRelaxationFits(problem, o->order > 0 ? o->order : problem.minimal_order(), o->solver);
     auto solver = sdp::MakeSolver(o->solver);
     const auto r = relax::SolveRelaxation(options, problem, *solver);
     const bool failed = r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid;

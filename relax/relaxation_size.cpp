@@ -20,8 +20,10 @@ double MonomialCount(int n, int d) {
 
 }  // namespace
 
+double BytesPerBlockEntry(const std::string& solver) { return solver == "dsdp" ? 1100.0 : 240.0; }
+
 RelaxationSize EstimateRelaxationSize(int num_vars, int order, const std::vector<int>& inequality_degrees,
-                                      const std::vector<int>& equality_degrees) {
+                                      const std::vector<int>& equality_degrees, const std::string& solver) {
   RelaxationSize s;
   s.num_vars = num_vars;
   s.order = order;
@@ -38,16 +40,16 @@ RelaxationSize EstimateRelaxationSize(int num_vars, int order, const std::vector
     squares += s.localizing_blocks.back() * s.localizing_blocks.back();
   }
   for (int d : equality_degrees) s.equality_rows += MonomialCount(num_vars, std::max(0, 2 * order - std::max(0, d)));
-  s.bytes = 8 * s.moments * s.moments + 80 * squares + 8 * s.moments * s.equality_rows;
+  s.bytes = 8 * s.moments * s.moments + BytesPerBlockEntry(solver) * squares + 8 * s.moments * s.equality_rows;
   return s;
 }
 
-RelaxationSize EstimateRelaxationSize(const PolyProblem& problem, int order) {
+RelaxationSize EstimateRelaxationSize(const PolyProblem& problem, int order, const std::string& solver) {
   std::vector<int> g, h;
   for (const auto& p : problem.inequalities) g.push_back(p.degree());
   g.insert(g.end(), problem.box.size(), 2);
   for (const auto& p : problem.equalities) h.push_back(p.degree());
-  return EstimateRelaxationSize(problem.num_vars, order, g, h);
+  return EstimateRelaxationSize(problem.num_vars, order, g, h, solver);
 }
 
 std::string FormatBytes(double bytes) {
