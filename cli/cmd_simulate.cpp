@@ -64,18 +64,13 @@ void AddSimulateCommand(CLI::App& app) {
     if (o->model.empty() || o->input.empty())
       throw InputError("simulate needs --model and --input, or --example NAME");
     const HwModel model = HwModel::load(o->model);
-    if (!model.linear.is_stable() && !o->allow_unstable)
-      throw InputError(fmt::format("{}: the linear block a = [{}] has a pole on or outside the unit circle, so its "
-                                   "output grows without bound; pass --allow-unstable to simulate it anyway",
-                                   o->model, fmt::join(model.linear.a, ", ")));
+    CheckStableOrAllowed(model, o->model, o->allow_unstable);
     const CsvTable in = read_recording(o->input, {o->u_col});
     const auto& u = in.column(o->u_col);
     const auto w = model.simulate(u);
-    for (std::size_t t = 0; t < w.size(); ++t)
-      if (!std::isfinite(w[t]))
-        throw InputError(fmt::format("{}: the simulated output overflows double precision at sample {} ({}:{}); "
-                                     "nothing was written",
-                                     o->model, t + 1, o->input, in.lines.at(t)));
+    CheckFiniteOutput(w, o->model, [&](std::size_t t) {
+      return t < in.lines.size() ? fmt::format("{}:{}", o->input, in.lines[t]) : fmt::format("{} sample {}", o->input, t + 1);
+    });
     std::mt19937_64 rng(o->seed);
     std::normal_distribution<double> gauss(0.0, 1.0);
     std::uniform_real_distribution<double> unif(-1.0, 1.0);

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/json_input.hpp"
 #include "core/recording.hpp"
 
 namespace hw::python {
@@ -146,14 +146,7 @@ CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::v
 
 nlohmann::json JsonFromPython(py::handle h, const std::string& what) {
   if (!py::isinstance<py::str>(h)) return ToJson(h);
-  const std::string path = h.cast<std::string>();
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({}): {}", path, what, e.what()));
-  }
+  return ReadJsonFile(h.cast<std::string>(), what);  // the CLI's reader, with its messages
 }
 
 void CheckPythonSignals() {

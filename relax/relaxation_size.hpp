@@ -30,6 +30,11 @@ RelaxationSize EstimateRelaxationSize(int num_vars, int order, const std::vector
                                       const std::vector<int>& equality_degrees);
 RelaxationSize EstimateRelaxationSize(const PolyProblem& problem, int order);
 
+// True when the order-`order` relaxation of `problem` fits in the memory available now; false with the numbers
+// (its size, the memory available, the largest order that fits) in *error otherwise. Computed from counts, before
+// anything is allocated; the CLI and the Python module refuse with this message.
+bool RelaxationFits(const PolyProblem& problem, int order, std::string* error);
+
 // Memory the system reports available now (MemAvailable of /proc/meminfo; physical memory when absent).
 double AvailableMemoryBytes();
 // "1.5 GB", "320 MB", "2.1e+12 GB".
