@@ -84,7 +84,8 @@ struct BoundsCliOptions {
 relax::HwData ReadData(const BoundsCliOptions& o) {
   std::vector<std::string> columns = {o.u_col, o.y_col};
   if (!o.noise_col.empty()) columns.push_back(o.noise_col);
-  const CsvTable table = read_recording(o.data, columns);
+  // A time column (t=VAR, or a CSV column t) is checked and not used: the model runs on the sample index.
+  const CsvTable table = read_recording(o.data, columns, {"t"});
   relax::HwData data;
   data.source = o.data;
   data.lines = table.lines;
@@ -277,7 +278,7 @@ void AddBoundsCommand(CLI::App& app) {
       "2 bad input; 1 other failure.",
       kExitInvalidated));
   auto o = std::make_shared<BoundsCliOptions>();
-  cmd->add_option("--data", o->data, "recording: CSV with a header, or FILE.mat:u=VAR,y=VAR (docs/recordings.md)")
+  cmd->add_option("--data", o->data, "recording: CSV with a header, or FILE.mat:u=VAR,y=VAR[,t=VAR] (docs/recordings.md)")
       ->required();
   cmd->add_option("--u-col", o->u_col, "input column");
   cmd->add_option("--y-col", o->y_col, "output column");

@@ -102,11 +102,9 @@ void AddChecked(CsvTable* table, const std::string& what, const std::string& nam
   table->add_column(name, std::move(values));
 }
 
-}  // namespace
-
-CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::vector<std::string>& required,
-                             const std::vector<std::string>& optional) {
-  if (py::isinstance<py::str>(h)) return read_recording(h.cast<std::string>(), required, optional);
+// A dict or tuple of arrays as a table of the columns asked for (their lengths checked).
+CsvTable TableFromPython(py::handle h, const std::string& what, const std::vector<std::string>& required,
+                         const std::vector<std::string>& optional) {
   CsvTable table;
   table.source = what;
   if (py::isinstance<py::tuple>(h)) {
@@ -141,6 +139,16 @@ CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::v
       }
       AddChecked(&table, what, name, ToVector(d[py::str(name)], fmt::format("{}['{}']", what, name)));
     }
+  return table;
+}
+
+}  // namespace
+
+CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::vector<std::string>& required,
+                             const std::vector<std::string>& optional) {
+  if (py::isinstance<py::str>(h)) return read_recording(h.cast<std::string>(), required, optional);
+  CsvTable table = TableFromPython(h, what, required, optional);
+  if (table.has("t")) CheckTimeColumn(table.column("t"), what, "t");  // as read_recording checks a file's
   return table;
 }
 

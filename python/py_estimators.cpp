@@ -70,7 +70,7 @@ std::vector<esmaeilani::Segment> Segments(py::handle h, const std::string& what)
   for (std::size_t i = 0; i < items.size(); ++i) {
     const std::string name =
         py::isinstance<py::str>(items[i]) ? items[i].cast<std::string>() : fmt::format("{}[{}]", what, i);
-    const CsvTable t = RecordingFromPython(items[i], name, {"u", "y"});
+    const CsvTable t = RecordingFromPython(items[i], name, {"u", "y"}, {"t"});  // t: checked, not used
     out.push_back({t.column("u"), t.column("y"), name});
   }
   return out;

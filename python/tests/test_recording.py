@@ -91,11 +91,12 @@ def test_h5py_files_as_users_write_them_read_like_their_csv_twin(twin, tmp_path,
     want = hwbounds.read_recording(csv)
     for k in ("t", "u", "y"):
         np.testing.assert_array_equal(got[k], want[k])
-    # The CLI reads it too: simulate on the .mat input writes the file it writes from the CSV.
+    # The CLI reads it too: simulate on the .mat input writes the file it writes from the CSV (whose t column
+    # it copies, as it copies the time the spec names).
     model = tmp_path / "model.json"
     model.write_text(MODEL_JSON)
     run_cli("simulate", "--model", model, "--input", csv, "--out", tmp_path / "from_csv.csv")
-    run_cli("simulate", "--model", model, "--input", f"{mat}:u=vir", "--out", tmp_path / "from_mat.csv")
+    run_cli("simulate", "--model", model, "--input", f"{mat}:u=vir,t=time", "--out", tmp_path / "from_mat.csv")
     assert (tmp_path / "from_mat.csv").read_text() == (tmp_path / "from_csv.csv").read_text()
 
 
