@@ -89,7 +89,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   a.structure.output_basis = relax::parse_basis(a.output_basis);
   RequireValid(a.structure);
   RequireValid(data);
-  // The CLI's checks of the same options (cli/cmd_bounds.cpp, CheckBoundsOptions), in its order.
+  // The CLI's checks of the same options (cli/cmd_bounds.cpp, CheckBoundsOptions).
   Require([&](std::string* e) { return relax::ValidHorizon(a.horizon, e); });
   if (a.order_given) Require([&](std::string* e) { return relax::ValidOrder(a.options.order, a.horizon, e); });
   a.options.order = a.order_given ? a.options.order : relax::MinimalOrder(a.horizon);
