@@ -6,6 +6,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
@@ -75,6 +76,7 @@ struct BoundsCliOptions {
   std::vector<std::string> box, params;
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
+  bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
   bool proper = false, no_cheap = false, no_edge_witnesses = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
 };
@@ -82,7 +84,8 @@ struct BoundsCliOptions {
 relax::HwData ReadData(const BoundsCliOptions& o) {
   std::vector<std::string> columns = {o.u_col, o.y_col};
   if (!o.noise_col.empty()) columns.push_back(o.noise_col);
-  const CsvTable table = read_recording(o.data, columns);
+  // A time column (t=VAR, or a CSV column t) is checked and not used: the model runs on the sample index.
+  const CsvTable table = read_recording(o.data, columns, {"t"});
   relax::HwData data;
   data.source = o.data;
   data.lines = table.lines;
@@ -91,7 +94,8 @@ relax::HwData ReadData(const BoundsCliOptions& o) {
   if (!o.noise_col.empty()) {
     data.noise_bound = table.column(o.noise_col);
   } else {
-    if (!(o.noise_bound > 0)) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
+    if (!o.noise_bound_given) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
+    RequireOption("--noise-bound", [&](std::string* e) { return relax::ValidNoiseBound(o.noise_bound, e); });
     data.noise_bound.assign(data.y.size(), o.noise_bound);
   }
   return data;
@@ -109,13 +113,19 @@ relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
   return structure;
 }
 
+// The option values the library checks (the Python module's checks, with the same messages), before any work.
+void CheckBoundsOptions(const BoundsCliOptions& o) {
+  RequireOption("--horizon", [&](std::string* e) { return relax::ValidHorizon(o.horizon, e); });
+  if (o.order_given) RequireOption("--order", [&](std::string* e) { return relax::ValidOrder(o.order, o.horizon, e); });
+  RequireOption("--solver", [&](std::string* e) { return sdp::ValidSolverName(o.solver, e); });
+  RequireOption("--threads", [&](std::string* e) { return relax::ValidThreads(o.threads, e); });
+  RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
+  RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
+}
+
 relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
-  const int minimal_order = std::max(1, (o.horizon + 2) / 2);
-  if (o.order > 0 && o.order < minimal_order)
-    throw InputError(fmt::format("--order {} is below the minimal order ceil((n+1)/2) = {} of horizon {}", o.order,
-                                 minimal_order, o.horizon));
   relax::BoundsOptions options;
-  options.order = o.order > 0 ? o.order : minimal_order;
+  options.order = o.order_given ? o.order : relax::MinimalOrder(o.horizon);
   options.solver = o.solver;
   options.threads = o.threads;
   options.executor = sdp::MakeExecutor(o.executor, o.threads);
@@ -127,6 +137,8 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.generation.verify.enabled = !o.no_verify;
   if (!o.quiet)  // one line per constraint-generation round, printed by the process that runs the job
     options.round_log = [](const std::string& line) { fmt::print(stderr, "  {}\n", line); };
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
   return options;
 }
 
@@ -266,12 +278,13 @@ void AddBoundsCommand(CLI::App& app) {
       "2 bad input; 1 other failure.",
       kExitInvalidated));
   auto o = std::make_shared<BoundsCliOptions>();
-  cmd->add_option("--data", o->data, "recording: CSV with a header, or FILE.mat:u=VAR,y=VAR (docs/recordings.md)")
+  cmd->add_option("--data", o->data, "recording: CSV with a header, or FILE.mat:u=VAR,y=VAR[,t=VAR] (docs/recordings.md)")
       ->required();
   cmd->add_option("--u-col", o->u_col, "input column");
   cmd->add_option("--y-col", o->y_col, "output column");
-  auto* noise_bound = cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value")
-                          ->check(CLI::PositiveNumber)
+  // --noise-bound, --horizon, --order, --solver, --threads, --executor, --contract-passes: checked in the
+  // callback by the library's checks (CheckBoundsOptions), which give the Python module's messages.
+  auto* noise_bound = cmd->add_option("--noise-bound", o->noise_bound, "constant bound |eta_t| <= value (> 0)")
                           ->default_str("");
   auto* noise_col =
       cmd->add_option("--noise-col", o->noise_col, "column with a per-sample noise bound (instead of --noise-bound)");
@@ -282,25 +295,21 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_flag("--proper", o->proper, "estimate b_0 too (proper, not strictly proper)");
   cmd->add_option("--input-basis", o->input_basis, "psi basis: poly:K or a list like 'w,w^3,tanh'");
   cmd->add_option("--output-basis", o->output_basis, "phi basis of the inverse output map");
-  cmd->add_option("--horizon", o->horizon, "dynamic horizon n")->check(CLI::Range(1, 20));
-  cmd->add_option("--order", o->order, "relaxation order delta, at least the minimal order ceil((n+1)/2)")
-      ->check(CLI::Range(1, 20))
-      ->default_str("minimal");
+  cmd->add_option("--horizon", o->horizon, "dynamic horizon n, 1..20");
+  auto* order = cmd->add_option("--order", o->order, "relaxation order delta, from the minimal order ceil((n+1)/2) to 20")
+                    ->default_str("minimal");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
-  cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
-  // Checked by BoundsOptions::IsValid, so that the CLI and the Python module give the same message.
+  cmd->add_option("--solver", o->solver, fmt::format("SDP backend: {}", fmt::join(sdp::AvailableSolvers(), ", ")));
   cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)");
   cmd->add_option("--executor", o->executor,
                   "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "
-                  "coordinates, the other ranks solve)")
-      ->check(CLI::IsMember({"fork", "inprocess", "mpi"}));
+                  "coordinates, the other ranks solve)");
   cmd->add_option("--run-dir", o->run_dir, "keep finished SDP results here; a rerun solves only the rest");
   cmd->add_flag("--no-cheap-pass", o->no_cheap, "solve every orthant at full order (no minimal-order screening)");
   cmd->add_flag("--no-edge-witnesses", o->no_edge_witnesses,
                 "solve every endpoint by SDP, also those a feasible point at the prior box edge settles");
   cmd->add_option("--contract-passes", o->contraction_passes,
-                  "cheap passes repeated in each orthant's contracted box (0 = no box contraction)")
-      ->check(CLI::Range(0, 10));
+                  "cheap passes repeated in each orthant's contracted box, 0..10 (0 = no box contraction)");
   auto* verify = cmd->add_flag("--verify", o->verify,
                                "verify every bound and emptiness certificate rigorously in interval arithmetic "
                                "(the default)");
@@ -310,15 +319,18 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--truth", o->truth, "comma list of true parameters, to report coverage (simulation studies)");
   cmd->add_option("--json", o->json_out, "write the result as JSON");
   cmd->add_flag("--quiet", o->quiet, "no progress lines");
-  cmd->callback([o] {
+  cmd->callback([o, order, noise_bound] {
+    o->order_given = order->count() > 0;
+    o->noise_bound_given = noise_bound->count() > 0;
+    CheckBoundsOptions(*o);
     if (!o->json_out.empty()) CheckOutputFile(o->json_out, "--json");
     if (!o->run_dir.empty()) CheckOutputDirectory(o->run_dir, "--run-dir");
     const relax::HwData data = ReadData(*o);
     const relax::HwStructure structure = ReadStructure(*o);
     const auto names = relax::MakeLayout(structure).names;
+    const relax::BoundsOptions options = MakeBoundsOptions(*o);
     const relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
-    const relax::BoundsOptions options = MakeBoundsOptions(*o);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
       relax::ComputeBounds(options, set);
       return;

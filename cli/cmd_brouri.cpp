@@ -46,18 +46,6 @@ NonlinearEstimate ReadNonlinearEstimate(const std::string& path) {
   });
 }
 
-std::string PlanStage(const nlohmann::json& j, const std::string& path) {
-  if (!j.is_object() || !j.contains("method") || j.at("method") != "brouri" || !j.contains("stage") ||
-      !j.at("stage").is_string())
-    throw InputError(fmt::format("{}: not a brouri plan (expected \"method\": \"brouri\" and a \"stage\"); write one "
-                                 "with `hwbounds brouri plan steps|sines`",
-                                 path));
-  const auto stage = j.at("stage").get<std::string>();
-  if (stage != "steps" && stage != "sines")
-    throw InputError(fmt::format("{}: stage '{}' must be 'steps' or 'sines'", path, stage));
-  return stage;
-}
-
 std::vector<double> Times(std::size_t n, double ts) {
   std::vector<double> t(n);
   for (std::size_t i = 0; i < n; ++i) t[i] = i * ts;
@@ -157,31 +145,54 @@ void AddBrouriPlan(CLI::App& brouri) {
   });
 }
 
+struct EstimateOpts {
+  std::string plan, data, out, y_col = "y", down_border = "leading-and-root";
+  int degree = 0, max_degree = 9, harmonic = 0;
+  double plateau_sigmas = 5.0;
+  bool no_zoh = false, joint_refit = false;
+};
+
+NonlinearOptions NonlinearOptionsOf(const EstimateOpts& o) {
+  NonlinearOptions opt;
+  opt.degree = o.degree;
+  opt.max_degree = o.max_degree;
+  opt.plateau_sigmas = o.plateau_sigmas;
+  opt.down_border = DownBorderMethodFromString(o.down_border);
+  opt.joint_refit = o.joint_refit;
+  return opt;
+}
+
+FrequencyOptions FrequencyOptionsOf(const EstimateOpts& o) {
+  FrequencyOptions opt;
+  opt.harmonic = o.harmonic;
+  opt.zoh_correction = !o.no_zoh;
+  return opt;
+}
+
 void AddBrouriEstimate(CLI::App& brouri) {
-  struct Opts {
-    std::string plan, data, out, y_col = "y", down_border = "leading-and-root";
-    int degree = 0, max_degree = 9, harmonic = 0;
-    double plateau_sigmas = 5.0;
-    bool no_zoh = false, joint_refit = false;
-  };
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<EstimateOpts>();
   auto* cmd = brouri.add_subcommand("estimate", "Estimate from recordings of a plan (stage 1 or 2, read from the plan)");
   cmd->add_option("--plan", o->plan, "plan.json written by `brouri plan`")->required();
   cmd->add_option("--data", o->data, "directory of the recordings")->default_str("the plan's directory");
   cmd->add_option("--y-col", o->y_col, "name of the measured-output column");
-  cmd->add_option("--degree", o->degree, "stage 1: degree p of h (0 = select from the data)")->check(CLI::Range(0, 15));
-  cmd->add_option("--max-degree", o->max_degree, "stage 1: largest degree the selection tries")->check(CLI::Range(1, 15));
+  // --degree, --max-degree, --plateau-sigmas, --harmonic: checked by NonlinearOptions/FrequencyOptions::IsValid
+  // before the recordings are read (the Python module's messages).
+  cmd->add_option("--degree", o->degree, "stage 1: degree p of h, 1..15 (0 = select from the data)");
+  cmd->add_option("--max-degree", o->max_degree, "stage 1: largest degree the selection tries, 1..15");
   cmd->add_option("--plateau-sigmas", o->plateau_sigmas, "stage 1: plateau test threshold in standard errors");
   cmd->add_option("--down-border", o->down_border,
                   "stage 1: S^d, d- reading: leading-and-root | paper-coefficients | root-and-slope");
   cmd->add_flag("--joint-refit", o->joint_refit,
                 "stage 1: refit h, d+, S^d, d- to both borders' points jointly (not in the paper; needs p + 4 points)");
-  cmd->add_option("--harmonic", o->harmonic, "stage 2: harmonic k used for |G| (0 = degree of h, eq. 37)")
-      ->check(CLI::Range(0, 15));
+  cmd->add_option("--harmonic", o->harmonic, "stage 2: harmonic k used for |G|, 1..15 (0 = degree of h, eq. 37)");
   cmd->add_flag("--no-zoh-correction", o->no_zoh, "stage 2: do not correct for the hold (sinc gain, Ts/2 delay)");
   cmd->add_option("--out", o->out, "result JSON")->required();
   cmd->callback([o] {
     CheckOutputFile(o->out, "--out");
+    const NonlinearOptions nonlinear = NonlinearOptionsOf(*o);
+    const FrequencyOptions frequency = FrequencyOptionsOf(*o);
+    std::string error;
+    if (!nonlinear.IsValid(&error) || !frequency.IsValid(&error)) throw InputError(error);
     const auto j = ReadJson(o->plan);
     const auto stage = PlanStage(j, o->plan);
     const std::string dir = o->data.empty() ? fs::path(o->plan).parent_path().string() : o->data;
@@ -189,12 +200,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
     nlohmann::json result;
     if (stage == "steps") {
       const StepPlan plan = FromFile(o->plan, [&] { return StepPlan::from_json(j); });
-      NonlinearOptions opt;
-      opt.degree = o->degree;
-      opt.max_degree = o->max_degree;
-      opt.plateau_sigmas = o->plateau_sigmas;
-      opt.down_border = DownBorderMethodFromString(o->down_border);
-      opt.joint_refit = o->joint_refit;
+      const NonlinearOptions& opt = nonlinear;
       const auto rec = ReadRecording(path_of(plan.file), plan.sample_time, o->y_col);
       Summary s;
       const auto est = EstimateFromSteps(plan, opt, rec.u, rec.y, &s);
@@ -215,9 +221,7 @@ void AddBrouriEstimate(CLI::App& brouri) {
       result = StepsResultJson(est, s);
     } else {
       const SinePlan plan = FromFile(o->plan, [&] { return SinePlan::from_json(j); });
-      FrequencyOptions opt;
-      opt.harmonic = o->harmonic;
-      opt.zoh_correction = !o->no_zoh;
+      const FrequencyOptions& opt = frequency;
       std::vector<FrequencyPoint> points;
       for (std::size_t i = 0; i < plan.experiments.size(); ++i) {
         const auto& e = plan.experiments[i];

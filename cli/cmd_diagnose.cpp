@@ -21,13 +21,13 @@ struct Opts {
 void Run(const Opts& p, bool t_named, bool valid_t_named) {
   CheckOutputDirectory(p.out, "--out");
   diagnose::DiagnoseOptions o = p.o;
-  if (p.model.empty() == p.fit.empty()) throw InputError("diagnose needs exactly one of --model FILE or --fit SPEC");
+  std::string err;
+  if (!diagnose::ValidNominalChoice(!p.model.empty(), !p.fit.empty(), &err)) throw InputError(err);
   if (!p.effects.empty()) o.candidates = diagnose::ParseCandidates(p.effects);
   o.state_variable = diagnose::ParseStateVariable(p.state_variable);
   o.try_pairs = !p.no_pairs;
   o.refit.estimate_initial_state = !p.no_initial_state;
   o.nominal_fit.refit.estimate_initial_state = !p.no_initial_state;
-  std::string err;
   if (!o.IsValid(&err)) throw InputError("diagnose: " + err);
   diagnose::ColumnNames ic = p.ident_cols, vc = p.valid_cols;
   ic.t_required = t_named;

@@ -29,7 +29,7 @@ void AddEsmaeilaniCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--data", o->data,
-                  "segments used for estimation (CSV with columns u,y, or FILE.mat:u=VAR,y=VAR; one segment per file)")
+                  "segments used for estimation (CSV with columns u,y, or FILE.mat:u=VAR,y=VAR[,t=VAR]; one segment per file)")
       ->required()
       ->expected(1, -1);
   cmd->add_option("--order", o->order, "order n of the linear block (observable canonical form)");
@@ -57,7 +57,8 @@ void AddEsmaeilaniCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "model JSON to write");
   cmd->callback([o] {
     auto load = [&](const std::string& path) {
-      const CsvTable t = read_recording(path, {o->u_col, o->y_col});
+      // A time column (t=VAR, or a CSV column t) is checked and not used: the estimator runs on the sample index.
+      const CsvTable t = read_recording(path, {o->u_col, o->y_col}, {"t"});
       esmaeilani::Segment s;
       s.u = t.column(o->u_col);
       s.y = t.column(o->y_col);

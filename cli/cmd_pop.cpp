@@ -1,5 +1,6 @@
 // `hwbounds pop`: one moment relaxation of a polynomial optimisation problem given as JSON.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
@@ -10,29 +11,6 @@
 #include "sdp/sdpa_format.hpp"
 
 namespace hw::cli {
-namespace {
-
-// Refuses, with the numbers, a relaxation whose estimated memory exceeds what the machine has now; says the
-// size of a large one that fits before building it.
-void CheckRelaxationFits(const relax::PolyProblem& problem, int order, const std::string& solver) {
-  const auto size = relax::EstimateRelaxationSize(problem, order, solver);
-  const double available = relax::AvailableMemoryBytes();
-  if (size.bytes > available) {
-    int fits = order;
-    while (fits > problem.minimal_order() && relax::EstimateRelaxationSize(problem, fits, solver).bytes > available) --fits;
-    const auto largest = relax::EstimateRelaxationSize(problem, fits, solver);
-    throw InputError(fmt::format(
-        "--order {}: the relaxation of this {}-variable problem is too large: {}, more than the {} of memory available; "
-        "{}",
-        order, problem.num_vars, size.describe(), relax::FormatBytes(available),
-        largest.bytes <= available
-            ? fmt::format("the largest order that fits is {} ({})", fits, relax::FormatBytes(largest.bytes))
-            : "even the minimal order does not fit"));
-  }
-  if (size.bytes > 1e8) fmt::print(stderr, "order {} relaxation: {}\n", order, size.describe());
-}
-
-}  // namespace
 
 void AddPopCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("pop", "Moment (Lasserre) relaxation of a polynomial optimisation problem (JSON)");
@@ -43,19 +21,26 @@ void AddPopCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("PROBLEM", o->problem, "problem JSON (see README: Polynomial problems)")->required();
-  cmd->add_option("--order", o->order, "relaxation order delta, at least the problem's minimal order")
-      ->check(CLI::Range(1, 1000000))
-      ->default_str("minimal");
-  cmd->add_option("--solver", o->solver, "SDP backend")->check(CLI::IsMember(sdp::AvailableSolvers()));
+  // --order and --solver are checked in the callback by the library's checks (the Python module's messages).
+  auto* order = cmd->add_option("--order", o->order, "relaxation order delta, at least the problem's minimal order")
+                    ->default_str("minimal");
+  cmd->add_option("--solver", o->solver, fmt::format("SDP backend: {}", fmt::join(sdp::AvailableSolvers(), ", ")));
   cmd->add_option("--export", o->export_path, "also write the SDP in SDPA sparse format (.dat-s)");
   cmd->add_flag("--json", o->json, "machine-readable output");
-  cmd->callback([o] {
+  cmd->callback([o, order] {
     if (!o->export_path.empty()) CheckOutputFile(o->export_path, "--export");
     const auto problem = relax::LoadPolyProblem(o->problem);
+    const bool order_given = order->count() > 0;
+    if (order_given)
+      RequireOption("--order", [&](std::string* e) { return relax::ValidRelaxationOrder(problem, o->order, e); });
+    RequireOption("--solver", [&](std::string* e) { return sdp::ValidSolverName(o->solver, e); });
     relax::RelaxationOptions options;
-    options.order = o->order;
-    relax::CheckRelaxationOrder(problem, o->order);
-    CheckRelaxationFits(problem, o->order > 0 ? o->order : problem.minimal_order(), o->solver);
+    options.order = order_given ? o->order : 0;  // 0: the minimal order
+    const int solve_order = order_given ? o->order : problem.minimal_order();
+    // Refused, with the numbers, when larger than the memory available now; a large one that fits is announced.
+    RequireOption("--order", [&](std::string* e) { return relax::RelaxationFits(problem, solve_order, o->solver, e); });
+    const auto size = relax::EstimateRelaxationSize(problem, solve_order, o->solver);
+    if (size.bytes > 1e8) fmt::print(stderr, "order {} relaxation: {}\n", solve_order, size.describe());
     auto solver = sdp::MakeSolver(o->solver);
     const auto r = relax::SolveRelaxation(options, problem, *solver);
     const bool failed = r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid;

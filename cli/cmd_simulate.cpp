@@ -12,10 +12,20 @@
 #include "core/recording.hpp"
 
 namespace hw::cli {
+namespace {
+
+std::vector<double> SampleIndex(std::size_t n) {
+  std::vector<double> t(n);
+  for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i);
+  return t;
+}
+
+}  // namespace
 
 void AddSimulateCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
-      "simulate", "Simulate a model (JSON) on an input CSV, or a built-in example; writes t,u,w,y[,noise_bound]");
+      "simulate", "Simulate a model (JSON) on an input CSV, or a built-in example; writes t,u,w,y[,noise_bound] (t: the input's "
+      "time column when it has one, else the sample index)");
   struct Opts {
     std::string model, input, out, u_col = "u", example;
     int samples = 1000;
@@ -26,7 +36,7 @@ void AddSimulateCommand(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   auto* model = cmd->add_option("--model", o->model, "model JSON (see README: Model JSON)");
-  auto* input = cmd->add_option("--input", o->input, "recording with the input column (CSV, or FILE.mat:u=VAR)");
+  auto* input = cmd->add_option("--input", o->input, "recording with the input column (CSV, or FILE.mat:u=VAR[,t=VAR])");
   auto* example = cmd->add_option("--example", o->example,
                                   "built-in example instead of --model/--input: cerone2011 (paper 001, Section VI)")
                       ->check(CLI::IsMember({"cerone2011"}));
@@ -49,9 +59,7 @@ void AddSimulateCommand(CLI::App& app) {
     if (!o->example.empty()) {
       const auto ex = SimulateCeroneExample(o->seed, o->samples, o->snr_db);
       CsvTable out;
-      std::vector<double> t(ex.u.size());
-      for (std::size_t i = 0; i < t.size(); ++i) t[i] = static_cast<double>(i);
-      out.add_column("t", t);
+      out.add_column("t", SampleIndex(ex.u.size()));
       out.add_column("u", ex.u);
       out.add_column("w", ex.w);
       out.add_column("y", ex.y);
@@ -64,26 +72,20 @@ void AddSimulateCommand(CLI::App& app) {
     if (o->model.empty() || o->input.empty())
       throw InputError("simulate needs --model and --input, or --example NAME");
     const HwModel model = HwModel::load(o->model);
-    if (!model.linear.is_stable() && !o->allow_unstable)
-      throw InputError(fmt::format("{}: the linear block a = [{}] has a pole on or outside the unit circle, so its "
-                                   "output grows without bound; pass --allow-unstable to simulate it anyway",
-                                   o->model, fmt::join(model.linear.a, ", ")));
-    const CsvTable in = read_recording(o->input, {o->u_col});
+    CheckStableOrAllowed(model, o->model, o->allow_unstable);
+    // The input's time column, when it has one (t=VAR, or a CSV column t), becomes the output's t.
+    const CsvTable in = read_recording(o->input, {o->u_col}, {"t"});
     const auto& u = in.column(o->u_col);
     const auto w = model.simulate(u);
-    for (std::size_t t = 0; t < w.size(); ++t)
-      if (!std::isfinite(w[t]))
-        throw InputError(fmt::format("{}: the simulated output overflows double precision at sample {} ({}:{}); "
-                                     "nothing was written",
-                                     o->model, t + 1, o->input, in.lines.at(t)));
+    CheckFiniteOutput(w, o->model, [&](std::size_t t) {
+      return t < in.lines.size() ? fmt::format("{}:{}", o->input, in.lines[t]) : fmt::format("{} sample {}", o->input, t + 1);
+    });
     std::mt19937_64 rng(o->seed);
     std::normal_distribution<double> gauss(0.0, 1.0);
     std::uniform_real_distribution<double> unif(-1.0, 1.0);
-    std::vector<double> y(w.size()), t(w.size());
-    for (std::size_t i = 0; i < w.size(); ++i) {
-      t[i] = static_cast<double>(i);
-      y[i] = w[i] + o->noise_std * gauss(rng) + o->noise_bound * unif(rng);
-    }
+    std::vector<double> y(w.size());
+    for (std::size_t i = 0; i < w.size(); ++i) y[i] = w[i] + o->noise_std * gauss(rng) + o->noise_bound * unif(rng);
+    const std::vector<double> t = in.has("t") ? in.column("t") : SampleIndex(w.size());
     CsvTable out;
     out.add_column("t", t);
     out.add_column("u", u);

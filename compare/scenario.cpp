@@ -12,6 +12,8 @@
 #include "core/json_input.hpp"
 #include "estimators/esmaeilani/valve_case.hpp"
 #include "relax/basis.hpp"
+#include "relax/set_membership.hpp"
+#include "sdp/sdp_solver.hpp"
 
 namespace hw::compare {
 namespace {
@@ -87,12 +89,11 @@ bool Scenario::IsValid(std::string* error) const {
     if (!backlash.IsValid(&e)) return fail("system: " + e);
   }
   const auto& sm = setmembership;
-  if (sm.samples < 10 || sm.horizon < 1 || sm.order < 1 || !(sm.box_half_width > 0))
-    return fail("setmembership: samples >= 10, horizon >= 1, order >= 1, box > 0");
-  if (sm.order < (sm.horizon + 2) / 2)
-    return fail(fmt::format("setmembership: order {} is below the minimal order ceil((n+1)/2) = {} for horizon {}",
-                            sm.order, (sm.horizon + 2) / 2, sm.horizon));
-  if (sm.solver != "sdpa" && sm.solver != "csdp" && sm.solver != "dsdp") return fail("setmembership.solver: sdpa, csdp or dsdp");
+  if (sm.samples < 10 || !(sm.box_half_width > 0)) return fail("setmembership: samples >= 10, box > 0");
+  std::string e;  // the bounds command's checks, with its messages
+  if (!relax::ValidHorizon(sm.horizon, &e) || !relax::ValidOrder(sm.order, sm.horizon, &e) ||
+      !sdp::ValidSolverName(sm.solver, &e))
+    return fail("setmembership: " + e);
   const auto& es = esmaeilani;
   if (es.segments < 1 || es.samples < 20 || es.hold_min < 1 || es.hold_max < es.hold_min || es.grid_f < 2 ||
       es.grid_g < 2 || es.max_iterations < 1)

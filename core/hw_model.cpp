@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
 #include "core/json_input.hpp"
@@ -228,6 +229,22 @@ double fit_percent(const std::vector<double>& y, const std::vector<double>& yhat
     den += (y[i] - mean) * (y[i] - mean);
   }
   return 100.0 * (1.0 - std::sqrt(num / std::max(den, 1e-300)));
+}
+
+void CheckStableOrAllowed(const HwModel& model, const std::string& source, bool allow_unstable) {
+  if (allow_unstable || model.linear.is_stable()) return;
+  throw InputError(fmt::format("{}: the linear block a = [{}] has a pole on or outside the unit circle, so its output "
+                               "grows without bound; allow unstable models to simulate it anyway (--allow-unstable, "
+                               "allow_unstable=True from Python)",
+                               source, fmt::join(model.linear.a, ", ")));
+}
+
+void CheckFiniteOutput(const std::vector<double>& w, const std::string& source,
+                       const std::function<std::string(std::size_t)>& where) {
+  for (std::size_t t = 0; t < w.size(); ++t)
+    if (!std::isfinite(w[t]))
+      throw InputError(fmt::format("{}: the simulated output overflows double precision at sample {} ({})", source,
+                                   t + 1, where(t)));
 }
 
 }  // namespace hw

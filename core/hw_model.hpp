@@ -5,6 +5,7 @@
 //
 // Linear block convention (paper 001 eq. 3, used everywhere in hwbounds):
 //   z_t = -sum_{i=1..na} a_i z_{t-i} + sum_{j=0..nb} b_j x_{t-delay-j}
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -57,6 +58,15 @@ struct HwModel {
   static HwModel load(const std::string& path);
   void save(const std::string& path) const;
 };
+
+// The checks of `simulate` (the CLI command and the Python function, one message each). `source` names the model
+// in messages: its file, or "model".
+// A model whose linear block is unstable (its output grows without bound) is refused unless `allow_unstable`.
+void CheckStableOrAllowed(const HwModel& model, const std::string& source, bool allow_unstable);
+// Every output sample finite; otherwise InputError naming the model, the first overflowing sample (1-based) and
+// `where(t)`, that sample's origin (e.g. "rec.csv:12").
+void CheckFiniteOutput(const std::vector<double>& w, const std::string& source,
+                       const std::function<std::string(std::size_t)>& where);
 
 // Fit percentage 100 (1 - ||y - yhat|| / ||y - mean(y)||) and RMSE: the project's figures of merit.
 double fit_percent(const std::vector<double>& y, const std::vector<double>& yhat);

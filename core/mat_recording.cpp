@@ -1,5 +1,6 @@
 #include "core/mat_recording.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -9,6 +10,9 @@
 
 #include <fmt/format.h>
 #include <matio.h>
+
+#include "core/mat_hdf5.hpp"
+#include "core/mat_source.hpp"
 
 namespace hw {
 namespace {
@@ -39,12 +43,6 @@ std::size_t Elements(const matvar_t& v) {
   std::size_t n = 1;
   for (int k = 0; k < v.rank; ++k) n *= v.dims[k];
   return n;
-}
-
-std::string Shape(const matvar_t& v) {
-  std::string s;
-  for (int k = 0; k < v.rank; ++k) s += (k ? "x" : "") + std::to_string(v.dims[k]);
-  return s.empty() ? "0x0" : s;
 }
 
 std::string ClassName(const matvar_t& v) {
@@ -98,13 +96,21 @@ std::vector<double> AsDoubleSamples(const matvar_t& v) {
   }
 }
 
-// An open .mat file, closed on scope exit.
-class MatFile {
+MatVariable Describe(const matvar_t& v) {
+  MatVariable out;
+  out.name = v.name ? v.name : "?";
+  for (int k = 0; k < v.rank; ++k) out.dims.push_back(v.dims[k]);
+  // MAT_C_EMPTY with data: a class libmatio does not know.
+  out.class_name = v.class_type == MAT_C_EMPTY && Elements(v) > 0 ? "" : ClassName(v);
+  out.numeric = !v.isLogical && IsNumericClass(v.class_type);
+  out.complex = v.isComplex;
+  return out;
+}
+
+// A v4, v5 or v7 file, read by libmatio; closed on scope exit.
+class MatioSource : public MatSource {
  public:
-  explicit MatFile(const std::string& path) : path_(path) {
-    if (std::filesystem::is_directory(path))
-      throw InputError(fmt::format("{}: is a directory; expected a MATLAB .mat file", path));
-    if (!std::ifstream(path)) throw InputError(fmt::format("{}: cannot open file", path));
+  explicit MatioSource(const std::string& path) : path_(path) {
     InstallMatioLog();
     matio_last_message.clear();
     mat_ = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
@@ -114,76 +120,107 @@ class MatFile {
                       "save it with MATLAB's save(...) or scipy.io.savemat",
                       path, MatioDetail()));
   }
-  ~MatFile() { Mat_Close(mat_); }
-  MatFile(const MatFile&) = delete;
-  MatFile& operator=(const MatFile&) = delete;
+  ~MatioSource() override { Mat_Close(mat_); }
+  MatioSource(const MatioSource&) = delete;
+  MatioSource& operator=(const MatioSource&) = delete;
 
-  // Every variable's header (no data), in file order.
-  std::vector<VarPtr> Headers() {
-    std::vector<VarPtr> out;
+  std::vector<MatVariable> Variables() override {
+    std::vector<MatVariable> out;
     Mat_Rewind(mat_);
-    while (matvar_t* v = Mat_VarReadNextInfo(mat_)) out.emplace_back(v);
+    while (matvar_t* v = Mat_VarReadNextInfo(mat_)) {
+      VarPtr info(v);
+      out.push_back(Describe(*info));
+    }
     return out;
   }
 
-  // "vir (300x1 double), qm (300x1 double)": what the file offers, for messages.
-  std::string Listing() {
-    std::string s;
-    for (const auto& v : Headers())
-      s += fmt::format("{}{} ({} {})", s.empty() ? "" : ", ", v->name ? v->name : "?", Shape(*v), ClassName(*v));
-    return s.empty() ? "no variables" : s;
-  }
-
-  // The variable's samples; throws InputError naming what is wrong with it.
-  std::vector<double> ReadVector(const std::string& name) {
+  std::optional<MatVariable> Find(const std::string& name) override {
     VarPtr info(Mat_VarReadInfo(mat_, name.c_str()));
     matio_last_message.clear();
-    if (!info) throw InputError(fmt::format("{}: no variable '{}'; the file has: {}", path_, name, Listing()));
-    CheckVector(*info, name);
-    VarPtr var(Mat_VarRead(mat_, name.c_str()));
+    if (!info) return std::nullopt;
+    return Describe(*info);
+  }
+
+  std::vector<double> ReadDoubles(const MatVariable& v) override {
+    VarPtr var(Mat_VarRead(mat_, v.name.c_str()));
     if (!var || !var->data)
-      throw InputError(fmt::format("{}: variable '{}' could not be read{}", path_, name, MatioDetail()));
-    auto values = AsDoubleSamples(*var);
-    for (std::size_t i = 0; i < values.size(); ++i)
-      if (!std::isfinite(values[i]))
-        throw InputError(fmt::format("{}: variable '{}' sample {} is {}; every sample must be a finite number", path_,
-                                     name, i + 1, values[i]));
-    return values;
+      throw InputError(fmt::format("{}: variable '{}' could not be read{}", path_, v.name, MatioDetail()));
+    return AsDoubleSamples(*var);
   }
 
  private:
-  void CheckVector(const matvar_t& v, const std::string& name) const {
-    const std::string what = fmt::format("{}: variable '{}' is a {} {} array", path_, name, Shape(v), ClassName(v));
-    if (v.class_type == MAT_C_EMPTY && Elements(v) > 0)  // data, but no class libmatio recognises
-      throw InputError(
-          fmt::format("{}: variable '{}' ({}) has no MATLAB class that libmatio recognises; in a v7.3 "
-                      "(HDF5) file every dataset needs a MATLAB_class attribute such as 'double', "
-                      "written null-terminated as MATLAB writes it",
-                      path_, name, Shape(v)));
-    if (v.isLogical || !IsNumericClass(v.class_type))
-      throw InputError(what + "; a recording variable must be numeric (double, single or integer)");
-    if (v.isComplex) throw InputError(what + " of complex numbers; a recording variable must be real");
-    const std::size_t n = Elements(v);
-    if (n == 0) throw InputError(what + " with no elements; a recording variable needs at least one sample");
-    int long_dims = 0;
-    for (int k = 0; k < v.rank; ++k) long_dims += v.dims[k] > 1;
-    if (long_dims > 1)
-      throw InputError(what + "; a recording variable must be a vector (1xN or Nx1): store one signal per variable");
-  }
-
   std::string path_;
   mat_t* mat_ = nullptr;
 };
 
+// The reader of the file's kind: libhdf5 for v7.3 (HDF5) files, libmatio for the others.
+std::unique_ptr<MatSource> OpenMat(const std::string& path) {
+  if (std::filesystem::is_directory(path))
+    throw InputError(fmt::format("{}: is a directory; expected a MATLAB .mat file", path));
+  if (!std::ifstream(path)) throw InputError(fmt::format("{}: cannot open file", path));
+  if (IsHdf5File(path)) return OpenHdf5Mat(path);
+  return std::make_unique<MatioSource>(path);
+}
+
+// "vir (300x1 double), qm (300x1 double)": what the file offers, for messages.
+std::string Listing(MatSource& file) {
+  std::string s;
+  for (const auto& v : file.Variables())
+    s += fmt::format("{}{} ({} {})", s.empty() ? "" : ", ", v.name, v.shape(),
+                     v.class_name.empty() ? "unknown class" : v.class_name);
+  return s.empty() ? "no variables" : s;
+}
+
+// A recording variable is a real, full, numeric vector with at least one sample; throws InputError naming
+// what it is otherwise.
+void CheckVector(const std::string& path, const MatVariable& v) {
+  const std::string what = fmt::format("{}: variable '{}' is a {} {} array", path, v.name, v.shape(), v.class_name);
+  if (v.class_name.empty())
+    throw InputError(fmt::format("{}: variable '{}' ({}) has no MATLAB class that the reader recognises; a recording "
+                                 "variable must be numeric (double, single or integer)",
+                                 path, v.name, v.shape()));
+  if (!v.numeric) throw InputError(what + "; a recording variable must be numeric (double, single or integer)");
+  if (v.complex) throw InputError(what + " of complex numbers; a recording variable must be real");
+  if (v.elements() == 0) throw InputError(what + " with no elements; a recording variable needs at least one sample");
+  const auto long_dims = std::count_if(v.dims.begin(), v.dims.end(), [](std::size_t d) { return d > 1; });
+  if (long_dims > 1)
+    throw InputError(what + "; a recording variable must be a vector (1xN or Nx1): store one signal per variable");
+}
+
+// The variable's samples; throws InputError naming what is wrong with it.
+std::vector<double> ReadVector(MatSource& file, const std::string& path, const std::string& name) {
+  const auto v = file.Find(name);
+  if (!v) throw InputError(fmt::format("{}: no variable '{}'; the file has: {}", path, name, Listing(file)));
+  CheckVector(path, *v);
+  auto values = file.ReadDoubles(*v);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      throw InputError(fmt::format("{}: variable '{}' sample {} is {}; every sample must be a finite number", path,
+                                   name, i + 1, values[i]));
+  return values;
+}
+
 }  // namespace
 
+std::size_t MatVariable::elements() const {
+  std::size_t n = 1;
+  for (const auto d : dims) n *= d;
+  return dims.empty() ? 0 : n;
+}
+
+std::string MatVariable::shape() const {
+  std::string s;
+  for (std::size_t k = 0; k < dims.size(); ++k) s += (k ? "x" : "") + std::to_string(dims[k]);
+  return s.empty() ? "0x0" : s;
+}
+
 CsvTable read_mat_columns(const std::string& path, const std::vector<MatColumn>& columns) {
-  MatFile file(path);
+  const auto file = OpenMat(path);
   CsvTable table;
   table.source = path;
   std::string first;  // the variable that set the length, for the message
   for (const auto& c : columns) {
-    auto values = file.ReadVector(c.variable);
+    auto values = ReadVector(*file, path, c.variable);
     if (!table.columns.empty() && values.size() != table.rows())
       throw InputError(
           fmt::format("{}: variable '{}' has {} samples but '{}' has {}; the variables of one recording "
@@ -196,10 +233,9 @@ CsvTable read_mat_columns(const std::string& path, const std::vector<MatColumn>&
 }
 
 std::vector<std::string> mat_variable_names(const std::string& path) {
-  MatFile file(path);
+  const auto file = OpenMat(path);
   std::vector<std::string> names;
-  for (const auto& v : file.Headers())
-    if (v->name) names.emplace_back(v->name);
+  for (const auto& v : file->Variables()) names.push_back(v.name);
   return names;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// Recordings stored as MATLAB .mat files (v4, v5 and v7.3/HDF5, read by libmatio).
+// Recordings stored as MATLAB .mat files: v4, v5 and v7 read by libmatio, v7.3 (HDF5) by libhdf5
+// (core/mat_source.hpp, core/mat_hdf5.hpp).
 // A recording is a set of named vectors of one length; each variable read becomes one table column.
 // Errors name the file, the variable, what is wrong and what would be right, as read_csv's do.
 #include <string>

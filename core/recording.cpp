@@ -93,7 +93,25 @@ CsvTable ReadCsv(const RecordingSpec& spec, const std::vector<std::string>& requ
   return table;
 }
 
+// The variable (.mat) or source column (CSV) that holds the column `column` of a recording.
+std::string SourceOf(const RecordingSpec& spec, const std::string& column) {
+  const auto* m = Find(spec.map, column);
+  return fmt::format("{} '{}'", spec.mat ? "variable" : "column", m ? m->variable : column);
+}
+
 }  // namespace
+
+void CheckTimeColumn(const std::vector<double>& t, const std::string& source, const std::string& what,
+                     const std::vector<int>& lines) {
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) continue;
+    const std::string where = i < lines.size() ? fmt::format("{}:{}: {}", source, lines[i], what)
+                                               : fmt::format("{}: {} sample {}", source, what, i + 1);
+    throw InputError(fmt::format("{} is {} after {}; the time t of a recording must increase strictly from sample "
+                                 "to sample",
+                                 where, t[i], t[i - 1]));
+  }
+}
 
 std::string DescribeColumns(const std::vector<std::string>& required, const std::vector<std::string>& optional) {
   std::string s = fmt::format("{}", fmt::join(required, ", "));
@@ -124,7 +142,11 @@ CsvTable read_recording(const std::string& text, const std::vector<std::string>&
         std::find(optional.begin(), optional.end(), m.column) == optional.end())
       throw InputError(fmt::format("'{}': unknown column '{}'; this command reads {}", text, m.column,
                                    DescribeColumns(required, optional)));
-  return spec.mat ? ReadMat(spec, required, optional) : ReadCsv(spec, required);
+  CsvTable table = spec.mat ? ReadMat(spec, required, optional) : ReadCsv(spec, required);
+  const bool reads_t = std::find(required.begin(), required.end(), "t") != required.end() ||
+                       std::find(optional.begin(), optional.end(), "t") != optional.end();
+  if (reads_t && table.has("t")) CheckTimeColumn(table.column("t"), spec.path, SourceOf(spec, "t"), table.lines);
+  return table;
 }
 
 }  // namespace hw

@@ -25,9 +25,16 @@ struct RecordingSpec {
 // there, `optional` ones may be. A map key outside required and optional is an error (it would be
 // ignored otherwise), as is a required column that neither the map nor the file provides.
 // A CSV keeps all its columns (mapped ones added under their new names); a .mat file gives only the
-// columns asked for.
+// columns asked for. The time column "t", when the command reads it and the recording has it, is checked
+// with CheckTimeColumn (as long as the other columns and finite, as every column, and strictly increasing).
 CsvTable read_recording(const std::string& spec, const std::vector<std::string>& required,
                         const std::vector<std::string>& optional = {});
+
+// The time column `t` of a recording (read_recording's, or one built from arrays): strictly increasing.
+// Throws InputError naming `source` (the file, or the argument), `what` (e.g. "variable 'time'",
+// "column 't'", "t"), the sample (its file line when `lines` has it) and the two values.
+void CheckTimeColumn(const std::vector<double>& t, const std::string& source, const std::string& what,
+                     const std::vector<int>& lines = {});
 
 // "u, y and optionally t": the columns a command reads, for messages.
 std::string DescribeColumns(const std::vector<std::string>& required, const std::vector<std::string>& optional);

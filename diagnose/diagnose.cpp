@@ -309,6 +309,14 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   return windows.IsValid(error) && refit.IsValid(error) && nominal_fit.IsValid(error);
 }
 
+bool ValidNominalChoice(bool has_model, bool has_fit, std::string* error) {
+  if (has_model != has_fit) return true;
+  if (error)
+    *error = "diagnose needs exactly one of model (--model FILE) or fit (--fit SPEC): the nominal model as Model "
+             "JSON, or the structure to fit it (linear:NA,NB[,DELAY] or hw:NA,NB,PIN,POUT[,DELAY])";
+  return false;
+}
+
 nlohmann::json Comparison::to_json() const {
   return {{"mse", mse}, {"mse_baseline", mse_baseline}, {"mse_ratio", ratio}, {"score", score}, {"z", z},
           {"significant", significant}};

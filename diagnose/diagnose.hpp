@@ -123,6 +123,10 @@ struct DiagnoseReport {
   double seconds = 0.0;
 };
 
+// Exactly one nominal model is given: a Model JSON (CLI --model, Python model) or a spec to fit it (--fit, fit).
+// False with the message the CLI and the Python module share in *error otherwise.
+bool ValidNominalChoice(bool has_model, bool has_fit, std::string* error);
+
 // ident and valid must hold equally long t, u, y. `nominal` must have no effect blocks. When
 // `structure` is given (the nominal's structure, e.g. from --fit), the baseline is also refitted from
 // fresh starts. Returns report->ok = false with a message when the inputs cannot be diagnosed.

@@ -122,10 +122,7 @@ Recording ParseRecording(const std::string& text, const std::string& source, con
     r.t.resize(r.u.size());
     for (std::size_t i = 0; i < r.t.size(); ++i) r.t[i] = static_cast<double>(i);
   }
-  for (std::size_t i = 1; i < r.t.size(); ++i)
-    if (!(r.t[i] > r.t[i - 1]))
-      throw InputError(fmt::format("{}: column '{}' must increase strictly (data row {}: {} after {})", source, c.t,
-                                   i + 1, r.t[i], r.t[i - 1]));
+  CheckTimeColumn(r.t, source, fmt::format("column '{}'", c.t));  // core/recording.hpp: one message everywhere
   if (r.u.size() < min_samples)
     throw InputError(fmt::format("{}: {} samples; the diagnosis needs at least {}", source, r.u.size(), min_samples));
   return r;
@@ -140,10 +137,7 @@ Recording MakeRecording(std::string name, std::vector<double> t, std::vector<dou
     t.resize(u.size());
     for (std::size_t i = 0; i < t.size(); ++i) t[i] = static_cast<double>(i);
   }
-  for (std::size_t i = 1; i < t.size(); ++i)
-    if (!(t[i] > t[i - 1]))
-      throw InputError(fmt::format("{}: column '{}' must increase strictly (data row {}: {} after {})", name, t_col,
-                                   i + 1, t[i], t[i - 1]));
+  CheckTimeColumn(t, name, fmt::format("column '{}'", t_col));
   if (u.size() < min_samples)
     throw InputError(fmt::format("{}: {} samples; the diagnosis needs at least {}", name, u.size(), min_samples));
   return {std::move(name), std::move(t), std::move(u), std::move(y)};

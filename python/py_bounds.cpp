@@ -9,6 +9,8 @@
 #include "python/py_convert.hpp"
 #include "python/py_module.hpp"
 #include "relax/set_membership.hpp"
+#include "sdp/job_executor.hpp"
+#include "sdp/sdp_solver.hpp"
 
 namespace hw::python {
 namespace {
@@ -51,8 +53,7 @@ std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::ve
 std::vector<double> NoiseBound(py::handle h, std::size_t n) {
   if (py::isinstance<py::float_>(h) || py::isinstance<py::int_>(h)) {
     const double b = h.cast<double>();
-    if (!(b > 0) || !std::isfinite(b))
-      throw py::value_error(fmt::format("noise_bound must be a positive number (got {}), or one bound per sample", b));
+    Require([&](std::string* e) { return relax::ValidNoiseBound(b, e); });
     return std::vector<double>(n, b);
   }
   return ToVector(h, "noise_bound");
@@ -73,6 +74,7 @@ struct BoundsArgs {
   relax::HwStructure structure;
   std::string input_basis, output_basis, executor;
   int horizon = 2;
+  bool order_given = false;  // false: the minimal order of the horizon
   relax::BoundsOptions options;
 };
 
@@ -87,12 +89,20 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   a.structure.output_basis = relax::parse_basis(a.output_basis);
   RequireValid(a.structure);
   RequireValid(data);
+  // The CLI's checks of the same options (cli/cmd_bounds.cpp, CheckBoundsOptions).
+  Require([&](std::string* e) { return relax::ValidHorizon(a.horizon, e); });
+  if (a.order_given) Require([&](std::string* e) { return relax::ValidOrder(a.options.order, a.horizon, e); });
+  a.options.order = a.order_given ? a.options.order : relax::MinimalOrder(a.horizon);
+  Require([&](std::string* e) { return sdp::ValidSolverName(a.options.solver, e); });
+  Require([&](std::string* e) { return relax::ValidThreads(a.options.threads, e); });
+  Require([&](std::string* e) { return sdp::ValidExecutorName(a.executor, e); });
+  Require([&](std::string* e) { return relax::ValidContractionPasses(a.options.contraction_passes, e); });
   if (a.executor == "mpi")
     throw py::value_error(
         "executor 'mpi' runs under mpirun from the CLI (`hwbounds bounds --executor mpi`); use "
         "'fork' or 'inprocess' from Python");
   a.options.executor = sdp::MakeExecutor(a.executor, a.options.threads);
-  RequireValid(a.options, "bounds options: ");
+  RequireValid(a.options);
   const auto names = relax::MakeLayout(a.structure).names;
   const relax::HwOuterSet set(a.structure, data, a.horizon, BoxFromPython(box, names));
   // Ctrl-C is checked while the engine waits for its jobs and at every progress report.
@@ -138,7 +148,8 @@ void DefineBounds(py::module_& m) {
         a.executor = std::move(executor);
         auto& op = a.options;
         // None = the minimal order ceil((n + 1) / 2) (at least 1), as the CLI's default "--order minimal".
-        op.order = order.is_none() ? std::max(1, (horizon + 2) / 2) : order.cast<int>();
+        a.order_given = !order.is_none();
+        if (a.order_given) op.order = order.cast<int>();
         op.solver = std::move(solver);
         op.threads = threads;
         op.run_dir = std::move(run_dir);

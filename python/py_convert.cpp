@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "core/json_input.hpp"
 #include "core/recording.hpp"
 
 namespace hw::python {
@@ -102,11 +102,9 @@ void AddChecked(CsvTable* table, const std::string& what, const std::string& nam
   table->add_column(name, std::move(values));
 }
 
-}  // namespace
-
-CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::vector<std::string>& required,
-                             const std::vector<std::string>& optional) {
-  if (py::isinstance<py::str>(h)) return read_recording(h.cast<std::string>(), required, optional);
+// A dict or tuple of arrays as a table of the columns asked for (their lengths checked).
+CsvTable TableFromPython(py::handle h, const std::string& what, const std::vector<std::string>& required,
+                         const std::vector<std::string>& optional) {
   CsvTable table;
   table.source = what;
   if (py::isinstance<py::tuple>(h)) {
@@ -144,16 +142,19 @@ CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::v
   return table;
 }
 
+}  // namespace
+
+CsvTable RecordingFromPython(py::handle h, const std::string& what, const std::vector<std::string>& required,
+                             const std::vector<std::string>& optional) {
+  if (py::isinstance<py::str>(h)) return read_recording(h.cast<std::string>(), required, optional);
+  CsvTable table = TableFromPython(h, what, required, optional);
+  if (table.has("t")) CheckTimeColumn(table.column("t"), what, "t");  // as read_recording checks a file's
+  return table;
+}
+
 nlohmann::json JsonFromPython(py::handle h, const std::string& what) {
   if (!py::isinstance<py::str>(h)) return ToJson(h);
-  const std::string path = h.cast<std::string>();
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({}): {}", path, what, e.what()));
-  }
+  return ReadJsonFile(h.cast<std::string>(), what);  // the CLI's reader, with its messages
 }
 
 void CheckPythonSignals() {

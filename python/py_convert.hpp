@@ -41,6 +41,14 @@ void RequireValid(const Options& options, const std::string& prefix = "") {
   if (!options.IsValid(&error)) throw py::value_error(prefix + error);
 }
 
+// Raises ValueError with the message of a failed check the library shares with the CLI (`check(&message)` is
+// false for a bad value), e.g. Require([&](std::string* e) { return relax::ValidHorizon(horizon, e); }).
+template <typename Check>
+void Require(Check&& check) {
+  std::string error;
+  if (!check(&error)) throw py::value_error(error);
+}
+
 // Runs `work` with the GIL released (long engine calls; other Python threads keep running).
 template <typename F>
 auto WithoutGil(F&& work) {

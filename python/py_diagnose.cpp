@@ -10,10 +10,13 @@
 namespace hw::python {
 namespace {
 
+// A recording: a spec string is read as `hwbounds diagnose --data SPEC` reads it (diagnose/recording.hpp);
+// arrays are checked as the CLI checks a file's columns.
 diagnose::Recording RecordingArg(py::handle h, const std::string& what) {
-  const std::string name = py::isinstance<py::str>(h) ? h.cast<std::string>() : what;
-  const CsvTable t = RecordingFromPython(h, name, {"u", "y"}, {"t"});
-  return diagnose::MakeRecording(name, t.has("t") ? t.column("t") : std::vector<double>{}, t.column("u"),
+  if (py::isinstance<py::str>(h))
+    return diagnose::ReadRecording(diagnose::RecordingSpec::Parse(h.cast<std::string>(), diagnose::ColumnNames{}));
+  const CsvTable t = RecordingFromPython(h, what, {"u", "y"}, {"t"});
+  return diagnose::MakeRecording(what, t.has("t") ? t.column("t") : std::vector<double>{}, t.column("u"),
                                  t.column("y"));
 }
 
@@ -27,8 +30,7 @@ py::dict RecordingDict(const diagnose::Recording& r) {
 
 py::object Diagnose(py::handle ident_arg, py::handle valid_arg, py::handle model, py::handle fit, py::handle effects,
                     diagnose::DiagnoseOptions o, py::handle out_dir) {
-  if (model.is_none() == fit.is_none())
-    throw py::value_error("diagnose needs exactly one of model (dict or file) or fit (spec)");
+  Require([&](std::string* e) { return diagnose::ValidNominalChoice(!model.is_none(), !fit.is_none(), e); });
   if (!effects.is_none())
     o.candidates = diagnose::ParseCandidates(py::isinstance<py::str>(effects)
                                                  ? effects.cast<std::string>()

@@ -70,7 +70,7 @@ std::vector<esmaeilani::Segment> Segments(py::handle h, const std::string& what)
   for (std::size_t i = 0; i < items.size(); ++i) {
     const std::string name =
         py::isinstance<py::str>(items[i]) ? items[i].cast<std::string>() : fmt::format("{}[{}]", what, i);
-    const CsvTable t = RecordingFromPython(items[i], name, {"u", "y"});
+    const CsvTable t = RecordingFromPython(items[i], name, {"u", "y"}, {"t"});  // t: checked, not used
     out.push_back({t.column("u"), t.column("y"), name});
   }
   return out;
@@ -101,12 +101,9 @@ py::object BrouriEstimate(py::handle plan_arg, py::handle recordings, const brou
                           const brouri::FrequencyOptions& frequency) {
   RequireValid(nonlinear);
   RequireValid(frequency);
-  const nlohmann::json j = JsonFromPython(plan_arg, "brouri plan");
-  const std::string stage = j.is_object() && j.value("method", "") == "brouri" ? j.value("stage", "") : "";
-  if (stage != "steps" && stage != "sines")
-    throw py::value_error(
-        "plan: not a brouri plan (expected \"method\": \"brouri\" and \"stage\": \"steps\" or "
-        "\"sines\"); write one with `hwbounds brouri plan steps|sines`");
+  const nlohmann::json j = JsonFromPython(plan_arg, "JSON file");  // as `brouri estimate --plan`
+  const std::string stage =
+      brouri::PlanStage(j, py::isinstance<py::str>(plan_arg) ? plan_arg.cast<std::string>() : "plan");
   const std::filesystem::path dir =
       py::isinstance<py::str>(plan_arg) ? std::filesystem::path(plan_arg.cast<std::string>()).parent_path() : "";
   if (recordings.is_none() && !py::isinstance<py::str>(plan_arg))

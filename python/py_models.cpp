@@ -1,9 +1,12 @@
 // hwbounds.read_recording, hwbounds.simulate, hwbounds.pop.
+#include <fmt/format.h>
+
 #include "core/hw_model.hpp"
 #include "core/recording.hpp"
 #include "python/py_convert.hpp"
 #include "python/py_module.hpp"
 #include "relax/pop_json.hpp"
+#include "relax/relaxation_size.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::python {
@@ -30,38 +33,50 @@ the CLI's message.)doc",
 void DefineModels(py::module_& m) {
   m.def(
       "simulate",
-      [](py::handle model, py::handle u) {
-        const HwModel hw = py::isinstance<py::str>(model) ? HwModel::load(model.cast<std::string>())
-                                                          : HwModel::from_json(ToJson(model));
+      [](py::handle model, py::handle u, bool allow_unstable) {
+        const std::string source = py::isinstance<py::str>(model) ? model.cast<std::string>() : "model";
+        const HwModel hw = py::isinstance<py::str>(model) ? HwModel::load(source) : HwModel::from_json(ToJson(model));
+        CheckStableOrAllowed(hw, source, allow_unstable);  // the CLI's checks (cli/cmd_simulate.cpp)
         const auto input = ToVector(u, "u");
-        return ToArray(WithoutGil([&] { return hw.simulate(input); }));
+        const auto w = WithoutGil([&] { return hw.simulate(input); });
+        CheckFiniteOutput(w, source, [](std::size_t t) { return fmt::format("u[{}]", t); });
+        return ToArray(w);
       },
       R"doc(Noise-free output w of a model (a dict in the README's Model JSON format, or the path of such a
-file) driven by the input u, simulated from rest as `hwbounds simulate` does. Returns a numpy array.)doc",
-      py::arg("model"), py::arg("u"));
+file) driven by the input u, simulated from rest as `hwbounds simulate` does. A model whose linear block is
+unstable is refused unless allow_unstable (the CLI's --allow-unstable), and an output that overflows double
+precision is an error, both with the CLI's message. Returns a numpy array.)doc",
+      py::arg("model"), py::arg("u"), py::kw_only(), py::arg("allow_unstable") = false);
 
   const relax::RelaxationOptions r;
   m.def(
       "pop",
-      [](py::handle problem, int order, const std::string& solver, double rank_tolerance, double extraction_tolerance) {
+      [](py::handle problem, py::object order, const std::string& solver, double rank_tolerance,
+         double extraction_tolerance) {
         const relax::PolyProblem p = py::isinstance<py::str>(problem)
                                          ? relax::LoadPolyProblem(problem.cast<std::string>())
                                          : relax::ParsePolyProblem(ToJson(problem), "problem");
+        // The CLI's checks of --order and --solver (cli/cmd_pop.cpp), in its order.
+        const bool order_given = !order.is_none();
+        if (order_given) Require([&](std::string* e) { return relax::ValidRelaxationOrder(p, order.cast<int>(), e); });
+        Require([&](std::string* e) { return sdp::ValidSolverName(solver, e); });
         relax::RelaxationOptions options;
-        options.order = order;
+        options.order = order_given ? order.cast<int>() : 0;  // 0: the minimal order
         options.rank_tolerance = rank_tolerance;
         options.extraction_tolerance = extraction_tolerance;
         RequireValid(options);
-        relax::CheckRelaxationOrder(p, order);
+        const int solve_order = order_given ? options.order : p.minimal_order();
+        Require([&](std::string* e) { return relax::RelaxationFits(p, solve_order, solver, e); });
         auto backend = sdp::MakeSolver(solver);
         const auto result = WithoutGil([&] { return relax::SolveRelaxation(options, p, *backend); });
         return ToPython(relax::RelaxationJson(p, result, solver));
       },
       R"doc(One moment (Lasserre) relaxation of a polynomial optimisation problem, as `hwbounds pop --json`.
 problem: a dict {"variables": [...], "minimize" | "maximize": "...", "constraints": [...], "box": {...}} or the
-path of such a JSON file; order 0 = minimal. Returns the CLI's JSON as a dict (status, bound when solved,
-flat, minimizers, ...).)doc",
-      py::arg("problem"), py::arg("order") = r.order, py::arg("solver") = "sdpa", py::kw_only(),
+path of such a JSON file; order None = the problem's minimal order (as the CLI without --order); an order
+below it, an unknown solver, or a relaxation larger than the memory available raise ValueError with the
+CLI's message. Returns the CLI's JSON as a dict (status, bound when solved, flat, minimizers, ...).)doc",
+      py::arg("problem"), py::arg("order") = py::none(), py::arg("solver") = "sdpa", py::kw_only(),
       py::arg("rank_tolerance") = r.rank_tolerance, py::arg("extraction_tolerance") = r.extraction_tolerance);
 }
 

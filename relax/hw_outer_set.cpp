@@ -47,6 +47,23 @@ bool HwData::IsValid(std::string* error) const {
   return true;
 }
 
+bool ValidHorizon(int horizon, std::string* error) {
+  if (horizon >= 1 && horizon <= kMaxHorizon) return true;
+  if (error) *error = fmt::format("horizon {} is out of range; the dynamic horizon n lies in 1..{}", horizon, kMaxHorizon);
+  return false;
+}
+
+int MinimalOrder(int horizon) { return std::max(1, (horizon + 2) / 2); }
+
+bool ValidNoiseBound(double noise_bound, std::string* error) {
+  if (noise_bound > 0 && std::isfinite(noise_bound)) return true;
+  if (error)
+    *error = fmt::format("noise_bound {} is not a positive finite number; |eta_t| <= noise_bound needs one (or give "
+                         "one bound per sample)",
+                         noise_bound);
+  return false;
+}
+
 std::string HwData::where(int t) const {
   if (t >= 0 && static_cast<std::size_t>(t) < lines.size()) return fmt::format("{}:{} (sample {})", source, lines[t], t + 1);
   return fmt::format("{}: sample {}", source, t + 1);
@@ -100,7 +117,7 @@ HwOuterSet::HwOuterSet(HwStructure structure, HwData data, int horizon, std::vec
   if (!data_.IsValid(&error)) throw InputError(error);
   layout_ = MakeLayout(structure_);
   const int n = layout_.count();
-  if (horizon_ < 1) throw InputError("the dynamic horizon n must be >= 1");
+  if (!ValidHorizon(horizon_, &error)) throw InputError(error);
   const int lag = std::max(structure_.na, structure_.nb);
   if (static_cast<int>(data_.y.size()) < lag + horizon_ + 1)
     throw InputError(fmt::format("{}: {} samples do not fit na = {}, nb = {} and horizon {}: at least {} are needed",

@@ -43,6 +43,17 @@ struct HwData {
   std::string where(int t) const;
 };
 
+// The dynamic horizon n in 1..kMaxHorizon; false with the message (shared by ComputeBounds, the CLI and the
+// Python module) in *error otherwise.
+constexpr int kMaxHorizon = 20;
+bool ValidHorizon(int horizon, std::string* error);
+// The smallest relaxation order of D^ss(n) (paper 001, Remark 3): ceil((n + 1) / 2), at least 1 for the box.
+int MinimalOrder(int horizon);
+
+// A constant noise bound |eta_t| <= noise_bound: positive and finite. False with the message (shared by the CLI's
+// --noise-bound and the Python module's noise_bound) in *error otherwise.
+bool ValidNoiseBound(double noise_bound, std::string* error);
+
 // The model class of paper 001's example: psi = phi = (w, w^2, w^3), na = nb = 2, strictly proper.
 HwStructure CeroneExampleStructure();
 

@@ -105,9 +105,13 @@ PolyProblem ParsePolyProblem(const nlohmann::json& j, const std::string& source)
 
 PolyProblem LoadPolyProblem(const std::string& path) { return ParsePolyProblem(ReadJsonFile(path, "problem JSON file"), path); }
 
-void CheckRelaxationOrder(const PolyProblem& problem, int order) {
-  if (order > 0 && order < problem.minimal_order())
-    throw InputError(fmt::format("order {} is below this problem's minimal order {}", order, problem.minimal_order()));
+bool ValidRelaxationOrder(const PolyProblem& problem, int order, std::string* error) {
+  if (order >= problem.minimal_order()) return true;
+  if (error)
+    *error = fmt::format("order {} is below this problem's minimal order {}; leave the order unset for the minimal "
+                         "order",
+                         order, problem.minimal_order());
+  return false;
 }
 
 nlohmann::json RelaxationJson(const PolyProblem& problem, const RelaxationResult& r, const std::string& solver) {

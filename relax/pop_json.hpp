@@ -19,8 +19,9 @@ namespace hw::relax {
 PolyProblem ParsePolyProblem(const nlohmann::json& j, const std::string& source);
 PolyProblem LoadPolyProblem(const std::string& path);
 
-// Throws InputError when `order` (0 = minimal) is below the problem's minimal order.
-void CheckRelaxationOrder(const PolyProblem& problem, int order);
+// An order asked for (the CLI's --order, the Python module's order): at least the problem's minimal order.
+// False with the message both report in *error otherwise (leaving the order unset selects the minimal order).
+bool ValidRelaxationOrder(const PolyProblem& problem, int order, std::string* error);
 // The outcome as `hwbounds pop --json` prints it (and the Python module returns): status, message, order, solver,
 // sdp_status, moments, blocks, flat, sense, and when solved bound, first_moments, minimizers, rank.
 nlohmann::json RelaxationJson(const PolyProblem& problem, const RelaxationResult& r, const std::string& solver);

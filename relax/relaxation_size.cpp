@@ -81,4 +81,21 @@ double AvailableMemoryBytes() {
   return static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
 }
 
+bool RelaxationFits(const PolyProblem& problem, int order, const std::string& solver, std::string* error) {
+  const auto size = EstimateRelaxationSize(problem, order, solver);
+  const double available = AvailableMemoryBytes();
+  if (size.bytes <= available) return true;
+  int fits = order;
+  while (fits > problem.minimal_order() && EstimateRelaxationSize(problem, fits, solver).bytes > available) --fits;
+  const auto largest = EstimateRelaxationSize(problem, fits, solver);
+  if (error)
+    *error = fmt::format(
+        "order {}: the relaxation of this {}-variable problem is too large: {}, more than the {} of memory available; "
+        "{}",
+        order, problem.num_vars, size.describe(), FormatBytes(available),
+        largest.bytes <= available ? fmt::format("the largest order that fits is {} ({})", fits, FormatBytes(largest.bytes))
+                                   : "even the minimal order does not fit");
+  return false;
+}
+
 }  // namespace hw::relax

@@ -36,6 +36,11 @@ RelaxationSize EstimateRelaxationSize(const PolyProblem& problem, int order, con
 // Bytes per entry of a PSD block that a solve with this backend holds (the memory model above).
 double BytesPerBlockEntry(const std::string& solver);
 
+// True when the order-`order` relaxation of `problem` fits in the memory available now; false with the numbers
+// (its size, the memory available, the largest order that fits) in *error otherwise. Computed from counts, before
+// anything is allocated; the CLI and the Python module refuse with this message.
+bool RelaxationFits(const PolyProblem& problem, int order, const std::string& solver, std::string* error);
+
 // Memory the system reports available now (MemAvailable of /proc/meminfo; physical memory when absent).
 double AvailableMemoryBytes();
 // "1.5 GB", "320 MB", "2.1e+12 GB".

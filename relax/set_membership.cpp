@@ -14,6 +14,7 @@
 #include "relax/full_pass.hpp"
 #include "relax/orthant_screen.hpp"
 #include "relax/row_reduction.hpp"
+#include "sdp/sdp_solver.hpp"
 
 namespace hw::relax {
 namespace {
@@ -84,18 +85,43 @@ std::vector<int> WantedParameters(const BoundsOptions& options, const HwOuterSet
 
 }  // namespace
 
+namespace {
+
+bool Fail(std::string* error, std::string message) {
+  if (error) *error = std::move(message);
+  return false;
+}
+
+}  // namespace
+
+bool ValidOrder(int order, int horizon, std::string* error) {
+  const int minimal = MinimalOrder(horizon);
+  if (order < minimal)
+    return Fail(error, fmt::format("order {} is below the minimal order ceil((n+1)/2) = {} of horizon {}; leave the "
+                                   "order unset for the minimal order",
+                                   order, minimal, horizon));
+  if (order > kMaxOrder)
+    return Fail(error, fmt::format("order {} is above the largest relaxation order {}", order, kMaxOrder));
+  return true;
+}
+
+bool ValidThreads(int threads, std::string* error) {
+  if (threads >= 0) return true;
+  return Fail(error, fmt::format("threads {} is negative; give 0 (one job per core) or the number of jobs", threads));
+}
+
+bool ValidContractionPasses(int passes, std::string* error) {
+  if (passes >= 0 && passes <= 10) return true;
+  return Fail(error, fmt::format("contraction_passes {} is out of range 0..10 (0 = no box contraction)", passes));
+}
+
 bool BoundsOptions::IsValid(std::string* error) const {
-  auto fail = [&](std::string m) {
-    if (error) *error = std::move(m);
-    return false;
-  };
-  if (order < 1) return fail("order must be >= 1");
-  if (threads < 0) return fail("threads must be >= 0");
-  if (contraction_passes < 0) return fail("contraction_passes must be >= 0");
+  auto fail = [&](std::string m) { return Fail(error, std::move(m)); };
+  if (order < 1 || order > kMaxOrder) return fail(fmt::format("order {} is out of range 1..{}", order, kMaxOrder));
+  if (!ValidThreads(threads, error) || !ValidContractionPasses(contraction_passes, error)) return false;
   if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
   if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
-  if (solver != "csdp" && solver != "sdpa" && solver != "dsdp")
-    return fail(fmt::format("solver '{}' unknown; expected csdp, sdpa or dsdp", solver));
+  if (!sdp::ValidSolverName(solver, error)) return false;
   if (!reduction.IsValid(error)) return false;
   if (!edge_witness.IsValid(error)) return false;
   return generation.IsValid(error);
@@ -170,10 +196,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   const BoundsOptions options = EngineOptions(caller_options);
   const auto t0 = Clock::now();
   // Minimal order from the constraint degrees: Remark 3, ceil((n + 1) / 2), and >= 1 for the box.
-  const int min_order = std::max(1, (set.horizon() + 2) / 2);
-  if (options.order < min_order)
-    throw InputError(fmt::format("order {} is below the minimal order {} for horizon {}", options.order, min_order,
-                                 set.horizon()));
+  const int min_order = MinimalOrder(set.horizon());
+  if (!ValidOrder(options.order, set.horizon(), &error)) throw InputError(error);
   // Order 1 (Shor) returns the box edges for these problems, so the cheap order is at least 2; with nothing
   // cheaper than the target order there is no separate cheap pass.
   const int cheap_order = options.cheap_pass ? std::min(options.order, std::max(min_order, 2)) : options.order;

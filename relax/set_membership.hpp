@@ -132,6 +132,18 @@ struct BoundsSummary {
   bool invalidated() const;
 };
 
+// Checks of a bounds run's settings, shared by ComputeBounds, the CLI and the Python module so that each bad
+// value gets one message everywhere. Each returns false with the message in *error; the message names the
+// setting as the Python keyword (the CLI adds its option's spelling in front).
+// (The horizon's check, ValidHorizon, and MinimalOrder are in relax/hw_outer_set.hpp.)
+constexpr int kMaxOrder = 20;
+// A relaxation order asked for at horizon n: MinimalOrder(n)..kMaxOrder.
+bool ValidOrder(int order, int horizon, std::string* error);
+// Parallel jobs: 0 (one per core) or more.
+bool ValidThreads(int threads, std::string* error);
+// Cheap passes in contracted boxes: 0 (no contraction)..10.
+bool ValidContractionPasses(int passes, std::string* error);
+
 BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                             const std::function<void(const BoundsProgress&)>& progress = {});
 

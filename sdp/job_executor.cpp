@@ -186,6 +186,12 @@ std::vector<JobResult> ForkExecutor::Map(const std::vector<std::string>& specs, 
   return out;
 }
 
+bool ValidExecutorName(const std::string& kind, std::string* error) {
+  if (kind == "inprocess" || kind == "fork" || kind == "mpi") return true;
+  if (error) *error = fmt::format("executor '{}' unknown; expected fork, inprocess or mpi", kind);
+  return false;
+}
+
 std::shared_ptr<JobExecutor> MakeExecutor(const std::string& kind, int workers) {
   if (kind == "inprocess") return std::make_shared<InProcessExecutor>();
   if (kind == "fork") return std::make_shared<ForkExecutor>(workers);

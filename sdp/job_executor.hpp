@@ -76,5 +76,8 @@ class ForkExecutor : public JobExecutor {
 
 // "inprocess", "fork" (workers processes) or, when built with MPI, "mpi" (MPI_COMM_WORLD).
 std::shared_ptr<JobExecutor> MakeExecutor(const std::string& kind, int workers);
+// True for "inprocess", "fork" or "mpi"; otherwise false with "executor 'NAME' unknown; expected ..." in *error.
+// (Whether this build has MPI is MakeExecutor's to say.)
+bool ValidExecutorName(const std::string& kind, std::string* error);
 
 }  // namespace hw::sdp

@@ -1,5 +1,6 @@
 #include "sdp/sdp_solver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -8,6 +9,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "sdp/csdp_backend.hpp"
 #include "sdp/dsdp_backend.hpp"
@@ -281,9 +283,18 @@ std::unique_ptr<SdpSolver> MakeSolver(const std::string& name) {
   if (name == "csdp") return std::make_unique<CsdpSolver>();
   if (name == "sdpa") return std::make_unique<SdpaSolver>();
   if (name == "dsdp") return std::make_unique<DsdpSolver>();
-  throw std::invalid_argument("unknown SDP solver '" + name + "'; available: csdp, sdpa, dsdp");
+  std::string error;
+  ValidSolverName(name, &error);
+  throw std::invalid_argument(error);
 }
 
 std::vector<std::string> AvailableSolvers() { return {"csdp", "sdpa", "dsdp"}; }
+
+bool ValidSolverName(const std::string& name, std::string* error) {
+  const auto names = AvailableSolvers();
+  if (std::find(names.begin(), names.end(), name) != names.end()) return true;
+  if (error) *error = fmt::format("solver '{}' unknown; expected {}", name, fmt::join(names, ", "));
+  return false;
+}
 
 }  // namespace hw::sdp

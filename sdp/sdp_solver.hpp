@@ -123,5 +123,8 @@ double RelativeGap(double primal, double dual);
 // "csdp", "sdpa" or "dsdp"; throws std::invalid_argument for other names.
 std::unique_ptr<SdpSolver> MakeSolver(const std::string& name);
 std::vector<std::string> AvailableSolvers();
+// True for a name of AvailableSolvers(); otherwise false with "solver 'NAME' unknown; expected ..." in *error
+// (the message of every caller: the engine, the CLI and the Python module).
+bool ValidSolverName(const std::string& name, std::string* error);
 
 }  // namespace hw::sdp

@@ -254,6 +254,18 @@ FrequencyPoint EstimateFromSine(const SinePlan& plan, std::size_t i, const Frequ
   return pt;
 }
 
+std::string PlanStage(const nlohmann::json& j, const std::string& source) {
+  if (!j.is_object() || !j.contains("method") || j.at("method") != "brouri" || !j.contains("stage") ||
+      !j.at("stage").is_string())
+    throw InputError(fmt::format("{}: not a brouri plan (expected \"method\": \"brouri\" and a \"stage\"); write one "
+                                 "with `hwbounds brouri plan steps|sines`",
+                                 source));
+  const auto stage = j.at("stage").get<std::string>();
+  if (stage != "steps" && stage != "sines")
+    throw InputError(fmt::format("{}: stage '{}' must be 'steps' or 'sines'", source, stage));
+  return stage;
+}
+
 Recording CheckRecording(const CsvTable& t, double sample_time, const std::string& y_col) {
   Recording r;
   r.y = t.column(y_col);

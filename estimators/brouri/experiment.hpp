@@ -61,6 +61,10 @@ struct SinePlan {
 SinePlan MakeSinePlan(const NonlinearEstimate& nonlinear, const std::vector<double>& omegas, double amplitude,
                       int samples_per_period, int periods, double settling_time);
 
+// The stage of a plan ("steps" or "sines"); InputError naming `source` (the plan's file, or "plan") when the JSON is
+// not a brouri plan. The CLI and the Python module read plans through it.
+std::string PlanStage(const nlohmann::json& plan, const std::string& source);
+
 // Estimation from recordings (u may be empty to skip the check that it matches the plan).
 NonlinearEstimate EstimateFromSteps(const StepPlan& plan, const NonlinearOptions& options,
                                     const std::vector<double>& u, const std::vector<double>& y, Summary* summary);

@@ -63,20 +63,22 @@ def test_cli_bounds_from_a_mat_file_equal_those_from_the_csv(recording, tmp_path
 
 
 def test_validation_errors_carry_the_cli_message(recording):
+    # Every option check against the CLI's: test_option_messages.py. Here: the exact texts, and the inputs.
     path, rec = recording
     args = ("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--quiet")
     with pytest.raises(ValueError) as e:
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, threads=-1)
-    assert str(e.value) == "bounds options: threads must be >= 0" == cli_error(*args, "--threads", -1)
+    assert str(e.value) == "threads -1 is negative; give 0 (one job per core) or the number of jobs"
+    assert cli_error(*args, "--threads", -1) == "--threads: " + str(e.value)
     with pytest.raises(ValueError) as e:
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], na=0, horizon=1, order=1)
     assert str(e.value) == "na must be >= 1" == cli_error(*args, "--na", 0)
     with pytest.raises(ValueError) as e:
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, solver="mosek")
-    assert str(e.value) == "bounds options: solver 'mosek' unknown; expected csdp, sdpa or dsdp"
-    with pytest.raises(ValueError, match=r"^bounds options: order must be >= 1$"):
+    assert str(e.value) == "solver 'mosek' unknown; expected csdp, sdpa, dsdp"
+    with pytest.raises(ValueError, match=r"^order 0 is below the minimal order ceil\(\(n\+1\)/2\) = 1 of horizon 1; "):
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=0)
-    with pytest.raises(ValueError, match=r"^noise_bound must be a positive number \(got 0\), or one bound per sample$"):
+    with pytest.raises(ValueError, match=r"^noise_bound 0 is not a positive finite number"):
         hwbounds.bounds(rec["u"], rec["y"], 0.0, horizon=1, order=1)
     with pytest.raises(ValueError, match=r"^data: u has 60 samples but y has 59$"):
         hwbounds.bounds(rec["u"], rec["y"][:-1], 0.1, horizon=1, order=1)

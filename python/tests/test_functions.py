@@ -37,7 +37,7 @@ def test_pop_equals_cli_json(capfd):
         assert hwbounds.pop(json.load(f), order=2, solver="csdp") == cli
     with pytest.raises(ValueError) as e:
         hwbounds.pop({"variables": ["x"], "minimize": "x^4", "box": {"x": [-1, 1]}}, order=1)
-    assert str(e.value) == "order 1 is below this problem's minimal order 2"
+    assert str(e.value) == "order 1 is below this problem's minimal order 2; leave the order unset for the minimal order"
 
 
 def test_simulate_equals_cli(tmp_path):

@@ -61,9 +61,84 @@ def test_h5py_v73_reads_back_like_its_csv_twin(twin, tmp_path):
         np.testing.assert_array_equal(got[k], rec[k])
 
 
+def write_h5py_as_a_user_would(path, variables, matlab_header, attribute="str"):
+    """A v7.3 file as h5py users write one: numpy vectors as they are (1-D, not transposed), MATLAB_class set
+    the h5py way -- "str": a variable-length UTF-8 string (h5py's default for a str), "bytes": null-padded fixed
+    length, None: no attribute -- and, with matlab_header, MATLAB's 512-byte user block and header."""
+    with h5py.File(path, "w", userblock_size=512 if matlab_header else 0) as f:
+        for name, array in variables.items():
+            ds = f.create_dataset(name, data=array)
+            if attribute == "str":
+                ds.attrs["MATLAB_class"] = "double"
+            elif attribute == "bytes":
+                ds.attrs["MATLAB_class"] = np.bytes_("double")
+    if matlab_header:
+        with open(path, "r+b") as f:
+            f.write(b"MATLAB 7.3 MAT-file, written by h5py".ljust(116) + b"\0" * 8 + b"\x00\x02IM")
+
+
+MODEL_JSON = ('{"type": "hammerstein_wiener", "input_nonlinearity": {"kind": "polynomial", '
+              '"coefficients": [1, 0.2]}, "linear": {"a": [-0.6], "b": [0, 1]}}')
+
+
+@pytest.mark.parametrize("matlab_header", [True, False], ids=["with-header", "no-header"])
+@pytest.mark.parametrize("attribute", ["str", "bytes", None], ids=["vlen-attr", "bytes-attr", "no-attr"])
+def test_h5py_files_as_users_write_them_read_like_their_csv_twin(twin, tmp_path, matlab_header, attribute):
+    csv, rec = twin
+    mat = tmp_path / "user.mat"
+    write_h5py_as_a_user_would(mat, {"vir": rec["u"], "qm": rec["y"], "time": rec["t"]}, matlab_header, attribute)
+    got = hwbounds.read_recording(f"{mat}:u=vir,y=qm,t=time")
+    want = hwbounds.read_recording(csv)
+    for k in ("t", "u", "y"):
+        np.testing.assert_array_equal(got[k], want[k])
+    # The CLI reads it too: simulate on the .mat input writes the file it writes from the CSV (whose t column
+    # it copies, as it copies the time the spec names).
+    model = tmp_path / "model.json"
+    model.write_text(MODEL_JSON)
+    run_cli("simulate", "--model", model, "--input", csv, "--out", tmp_path / "from_csv.csv")
+    run_cli("simulate", "--model", model, "--input", f"{mat}:u=vir,t=time", "--out", tmp_path / "from_mat.csv")
+    assert (tmp_path / "from_mat.csv").read_text() == (tmp_path / "from_csv.csv").read_text()
+
+
+@pytest.mark.parametrize("variables, spec, message", [
+    pytest.param({"m": np.ones((3, 4)), "y": np.ones(3)}, ":u=m", "variable 'm' is a 4x3 double array; a recording variable "
+                                                      "must be a vector", id="matrix"),
+    pytest.param({"flags": np.array([True, False, True]), "y": np.ones(3)}, ":u=flags", "variable 'flags' is a 3x1 logical array; "
+                                                                            "a recording variable must be numeric", id="bool"),
+    pytest.param({"z": np.array([1 + 1j, 2, 3]), "y": np.ones(3)}, ":u=z", "variable 'z' is a 3x1 double array of complex numbers",
+                 id="complex"),
+    pytest.param({"u": np.array([1.0, np.inf]), "y": np.ones(2)}, "", "variable 'u' sample 2 is inf; every sample must be a finite",
+                 id="inf"),
+    pytest.param({"u": np.ones(4), "y": np.ones(3)}, "", "variable 'y' has 3 samples but 'u' has 4", id="lengths"),
+    pytest.param({"vir": np.ones(4)}, ":u=vin,y=vir", "no variable 'vin'; the file has: vir (4x1 double)",
+                 id="missing"),
+])
+def test_bad_h5py_input_names_file_variable_and_fault(tmp_path, variables, spec, message):
+    mat = tmp_path / "bad.mat"
+    with h5py.File(mat, "w") as f:
+        for name, array in variables.items():
+            f[name] = array
+    with pytest.raises(ValueError) as e:
+        hwbounds.read_recording(f"{mat}{spec}")
+    assert str(mat) in str(e.value)
+    assert message in str(e.value)
+    assert message in cli_error("diagnose", "--data", f"{mat}{spec}", "--validate", f"{mat}{spec}",
+                                "--fit", "linear:1,1", "--out", tmp_path / "d")
+
+
+def test_hdf5_file_that_is_not_readable_names_the_file(tmp_path):
+    mat = tmp_path / "cut.mat"
+    write_h5py_as_a_user_would(mat, {"u": np.arange(1000.0), "y": np.arange(1000.0)}, True)
+    data = mat.read_bytes()
+    mat.write_bytes(data[:len(data) // 2])  # a truncated copy
+    with pytest.raises(ValueError) as e:
+        hwbounds.read_recording(str(mat))
+    assert str(e.value).startswith(f"{mat}: ")
+
+
 def test_committed_fixtures_match_their_csv_twin():
     want = hwbounds.read_recording(os.path.join(TEST_DATA, "recording.csv"))
-    for name in ("recording_v5.mat", "recording_v73.mat"):
+    for name in ("recording_v5.mat", "recording_v73.mat", "recording_v73_nullpad.mat"):
         got = hwbounds.read_recording(os.path.join(TEST_DATA, name) + ":u=vir,y=qm,t=time")
         for k in ("t", "u", "y"):
             np.testing.assert_array_equal(got[k], want[k])

@@ -8,7 +8,7 @@ recording_v5.mat     MATLAB v5, written by scipy.io.savemat: time (1x40), vir (4
 recording_v73.mat    MATLAB v7.3 (HDF5 with MATLAB's 512-byte header), written by h5py as MATLAB does:
                      time (40x1), vir (40x1), qm (1x40), each dataset with its MATLAB_class attribute
 recording_v73_nullpad.mat  the same, but MATLAB_class written as h5py writes a bytes attribute (null-padded,
-                     not null-terminated): libmatio cannot tell the class then (tests the error message)
+                     not null-terminated), which libmatio does not recognise; the libhdf5 reader does
 """
 import os
 
