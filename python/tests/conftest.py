@@ -35,3 +35,15 @@ def load_json(path):
 
 def without(d, *keys):
     return {k: v for k, v in d.items() if k not in keys}
+
+
+def esmaeilani_signals(model, segments=2, seed=5):
+    """Piecewise-constant inputs (20 levels held 10 samples) and the model's output plus 0.01 noise, per segment."""
+    import numpy as np
+    import hwbounds
+    rng = np.random.default_rng(seed)
+    signals = []
+    for _ in range(segments):
+        u = np.repeat(rng.uniform(-1, 1, 20), 10)
+        signals.append((u, hwbounds.simulate(model, u) + 0.01 * rng.standard_normal(u.size)))
+    return signals

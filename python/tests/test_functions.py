@@ -8,7 +8,7 @@ import pytest
 import scipy.io
 
 import hwbounds
-from conftest import SOURCE_DIR, cli_error, load_json, run_cli, without
+from conftest import SOURCE_DIR, cli_error, esmaeilani_signals, load_json, run_cli, without
 
 PROBLEM = os.path.join(SOURCE_DIR, "paper_examples", "problems", "gloptipoly_constrained.json")
 MODEL = {"type": "hammerstein_wiener", "name": "test",
@@ -103,12 +103,7 @@ def test_diagnose_option_errors_are_the_clis(backlash_pair):
 @pytest.fixture(scope="module")
 def esmaeilani_segments(tmp_path_factory):
     d = tmp_path_factory.mktemp("esm")
-    rng = np.random.default_rng(5)
-    paths = []
-    for i in range(2):
-        u = np.repeat(rng.uniform(-1, 1, 20), 10)
-        y = hwbounds.simulate(MODEL, u) + 0.01 * rng.standard_normal(u.size)
-        paths.append(write_csv(d / f"seg{i}.csv", {"u": u, "y": y}))
+    paths = [write_csv(d / f"seg{i}.csv", {"u": u, "y": y}) for i, (u, y) in enumerate(esmaeilani_signals(MODEL))]
     return paths, d
 
 

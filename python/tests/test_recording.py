@@ -81,6 +81,17 @@ MODEL_JSON = ('{"type": "hammerstein_wiener", "input_nonlinearity": {"kind": "po
               '"coefficients": [1, 0.2]}, "linear": {"a": [-0.6], "b": [0, 1]}}')
 
 
+def assert_bad_mat_reported(mat, spec, message, tmp_path):
+    """read_recording raises the message with the file name; the CLI says the same, with exit code 2 (diagnose
+    reads u, y and optionally t, as read_recording's default)."""
+    with pytest.raises(ValueError) as e:
+        hwbounds.read_recording(f"{mat}{spec}")
+    assert str(mat) in str(e.value)
+    assert message in str(e.value)
+    assert message in cli_error("diagnose", "--data", f"{mat}{spec}", "--validate", f"{mat}{spec}",
+                                "--fit", "linear:1,1", "--out", tmp_path / "d")
+
+
 @pytest.mark.parametrize("matlab_header", [True, False], ids=["with-header", "no-header"])
 @pytest.mark.parametrize("attribute", ["str", "bytes", None], ids=["vlen-attr", "bytes-attr", "no-attr"])
 def test_h5py_files_as_users_write_them_read_like_their_csv_twin(twin, tmp_path, matlab_header, attribute):
@@ -118,12 +129,7 @@ def test_bad_h5py_input_names_file_variable_and_fault(tmp_path, variables, spec,
     with h5py.File(mat, "w") as f:
         for name, array in variables.items():
             f[name] = array
-    with pytest.raises(ValueError) as e:
-        hwbounds.read_recording(f"{mat}{spec}")
-    assert str(mat) in str(e.value)
-    assert message in str(e.value)
-    assert message in cli_error("diagnose", "--data", f"{mat}{spec}", "--validate", f"{mat}{spec}",
-                                "--fit", "linear:1,1", "--out", tmp_path / "d")
+    assert_bad_mat_reported(mat, spec, message, tmp_path)
 
 
 def test_hdf5_file_that_is_not_readable_names_the_file(tmp_path):
@@ -171,13 +177,7 @@ def test_cli_reads_the_mat_file_like_the_csv(twin, tmp_path):
 def test_bad_mat_input_names_file_variable_and_fault(tmp_path, variables, spec, message):
     mat = tmp_path / "bad.mat"
     scipy.io.savemat(mat, variables)
-    with pytest.raises(ValueError) as e:
-        hwbounds.read_recording(f"{mat}{spec}")
-    assert str(mat) in str(e.value)
-    assert message in str(e.value)
-    # The CLI says the same, with exit code 2 (diagnose reads u, y and optionally t, as read_recording's default).
-    assert message in cli_error("diagnose", "--data", f"{mat}{spec}", "--validate", f"{mat}{spec}",
-                                "--fit", "linear:1,1", "--out", tmp_path / "d")
+    assert_bad_mat_reported(mat, spec, message, tmp_path)
 
 
 def test_arrays_from_python_are_checked_like_recordings():

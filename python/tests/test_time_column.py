@@ -10,7 +10,7 @@ import pytest
 import scipy.io
 
 import hwbounds
-from conftest import CERONE_N300, cli_error, load_json, run_cli, without
+from conftest import CERONE_N300, cli_error, esmaeilani_signals, load_json, run_cli, without
 
 N = 60
 MODEL = {"type": "hammerstein_wiener", "input_nonlinearity": {"kind": "polynomial", "coefficients": [1, 0.3]},
@@ -78,11 +78,8 @@ def test_simulate_writes_the_inputs_time(cerone_mat, tmp_path):
 @pytest.fixture(scope="module")
 def esmaeilani_mats(tmp_path_factory):
     d = tmp_path_factory.mktemp("esm_time")
-    rng = np.random.default_rng(5)
     paths = []
-    for i in range(2):
-        u = np.repeat(rng.uniform(-1, 1, 20), 10)
-        y = hwbounds.simulate(MODEL, u) + 0.01 * rng.standard_normal(u.size)
+    for i, (u, y) in enumerate(esmaeilani_signals(MODEL)):
         path = d / f"seg{i}.mat"
         scipy.io.savemat(path, {"vin": u, "vout": y, **time_variants(u.size)})
         paths.append(str(path))
