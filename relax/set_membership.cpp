@@ -83,10 +83,7 @@ std::vector<int> WantedParameters(const BoundsOptions& options, const HwOuterSet
   return wanted;
 }
 
-}  // namespace
-
-namespace {
-
+// Sets *error (when given) and returns false: the tail of every IsValid-style check below.
 bool Fail(std::string* error, std::string message) {
   if (error) *error = std::move(message);
   return false;
