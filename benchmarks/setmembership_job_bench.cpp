@@ -23,8 +23,9 @@ int main(int argc, char** argv) {
   CLI::App app{"One set-membership relaxation job, round by round"};
   int samples = 1000, horizon = 2, order = 2, add = 20, orthant = -1;
   std::string param = "a1", solver_name = "sdpa";
-  bool maximize = false, verify = false;
-  int contract_rounds = 0;
+  bool maximize = false, verify = false, no_linear_rows = false;
+  int contract_rounds = 0, block_order_cap = -1;
+  double gap = 1e-7, feasibility = 1e-7;
   bool keep_prior_box = false;
   double box = 10.0;
   std::vector<double> box_list;
@@ -40,6 +41,10 @@ int main(int argc, char** argv) {
   app.add_option("--box-list", box_list, "lo1,hi1,...,lo8,hi8: a box per parameter (overrides --box)")
       ->delimiter(',');
   app.add_flag("--verify", verify);
+  app.add_flag("--no-linear-rows", no_linear_rows, "candidates without a block are left out (not scalar rows)");
+  app.add_option("--gap", gap, "the solver's relative gap tolerance");
+  app.add_option("--feasibility", feasibility, "the solver's relative feasibility tolerance");
+  app.add_option("--block-order-cap", block_order_cap, "data-row blocks of order <= this (-1: full order)");
   app.add_flag("--keep-prior-box", keep_prior_box,
                "scale variables by --box-list but constrain them by the prior box --box only (an affine change of "
                "variables: the same relaxation, other conditioning)");
@@ -103,6 +108,10 @@ int main(int argc, char** argv) {
   gen.verify.enabled = verify;
   gen.sdp.acceptable_gap = 1e-5;
   gen.sdp.infeasibility_tolerance = 0.5;
+  gen.sdp.gap_tolerance = gap;
+  gen.sdp.feasibility_tolerance = feasibility;
+  gen.block_order_cap = block_order_cap;
+  gen.linear_rows_first = !no_linear_rows;
   auto solver = hw::sdp::MakeSolver(solver_name);
   fmt::print("N={} n={} order={} orthant {} {} {} ({} candidates), solver {}\n", samples, horizon, order, l,
              maximize ? "max" : "min", param, candidates.size(), solver_name);
@@ -111,7 +120,7 @@ int main(int argc, char** argv) {
   int round = 0;
   const auto r = hw::relax::SolveWithConstraintGeneration(
       gen, core, candidates, {}, *solver, [&](const hw::relax::GenerationRound& r) {
-        fmt::print("{:>5} {:>5} {:>9.2f}  {} bound {:.6f}\n", ++round, r.blocks, since(t0), r.status, r.bound);
+        fmt::print("{:>5} {:>5} {:>9.2f}  {} bound {:.8f}\n", ++round, r.blocks, since(t0), r.status, r.bound);
         std::fflush(stdout);
       });
   fmt::print("status {} bound {:.6f} (original units {:.6f}) tight {} rounds {} iterations {} solver {:.2f} s of "

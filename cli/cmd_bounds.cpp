@@ -72,7 +72,7 @@ bool ModelInvalidated(const relax::BoundsSummary& s) { return s.orthants_total >
 
 struct BoundsCliOptions {
   std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
-  std::string solver = "sdpa", json_out, run_dir, truth, executor = "fork";
+  std::string solver = "auto", json_out, run_dir, truth, executor = "fork";
   std::vector<std::string> box, params;
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
@@ -117,10 +117,19 @@ relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
 void CheckBoundsOptions(const BoundsCliOptions& o) {
   RequireOption("--horizon", [&](std::string* e) { return relax::ValidHorizon(o.horizon, e); });
   if (o.order_given) RequireOption("--order", [&](std::string* e) { return relax::ValidOrder(o.order, o.horizon, e); });
-  RequireOption("--solver", [&](std::string* e) { return sdp::ValidSolverName(o.solver, e); });
+  RequireOption("--solver", [&](std::string* e) { return relax::ValidBoundsSolver(o.solver, e); });
   RequireOption("--threads", [&](std::string* e) { return relax::ValidThreads(o.threads, e); });
   RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
   RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
+}
+
+// "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
+std::string SolverText(const relax::BoundsOptions& options) {
+  if (options.solver != "auto") return options.solver;
+  std::vector<std::string> parts;
+  for (int d = std::min(options.order, 2); d <= options.order; ++d)  // the cheap pass runs at order 2 at most
+    parts.push_back(fmt::format("{} at order {}", relax::SolverForOrder("auto", d), d));
+  return fmt::format("auto ({})", fmt::join(parts, ", "));
 }
 
 relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
@@ -208,6 +217,9 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
   if (summary.edge_witness_solves > 0)
     fmt::print("feasible points at the box edges: {} endpoint(s) settled without an SDP ({} local solves, {:.1f} s)\n",
                summary.edge_witness_settled, summary.edge_witness_solves, summary.edge_witness_seconds);
+  if (summary.jobs_stopped_beyond_witness > 0)
+    fmt::print("{} relaxation job(s) ended early: their bound passed a certified feasible point's value, so further "
+               "rounds could not move the endpoint\n", summary.jobs_stopped_beyond_witness);
   for (const auto& r : summary.row_reduction) {
     std::string steps;
     for (const auto& c : r.at("per_step"))
@@ -299,7 +311,9 @@ void AddBoundsCommand(CLI::App& app) {
   auto* order = cmd->add_option("--order", o->order, "relaxation order delta, from the minimal order ceil((n+1)/2) to 20")
                     ->default_str("minimal");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
-  cmd->add_option("--solver", o->solver, fmt::format("SDP backend: {}", fmt::join(sdp::AvailableSolvers(), ", ")));
+  cmd->add_option("--solver", o->solver,
+                  fmt::format("SDP backend: auto (CSDP up to order 2, DSDP from order 3; docs/sdp.md), {}",
+                              fmt::join(sdp::AvailableSolvers(), ", ")));
   cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)");
   cmd->add_option("--executor", o->executor,
                   "where SDP jobs run: fork (local worker processes), inprocess, or mpi (under mpirun: rank 0 "
@@ -344,7 +358,7 @@ void AddBoundsCommand(CLI::App& app) {
     fmt::print("hwbounds bounds: {} samples from {}, na={} nb={} horizon n={} order delta={}, {} parameters, "
                "{} sign orthants, solver {}, jobs on {} ({} workers)\n",
                data.y.size(), o->data, o->na, o->nb, o->horizon, options.order, names.size(), set.num_orthants(),
-               o->solver, options.executor->name(), options.executor->workers());
+               SolverText(options), options.executor->name(), options.executor->workers());
     auto progress = [o](const relax::BoundsProgress& p) {
       if (o->quiet) return;
       if (p.total < 0) {  // a one-off message

@@ -92,7 +92,7 @@ bool Scenario::IsValid(std::string* error) const {
   if (sm.samples < 10 || !(sm.box_half_width > 0)) return fail("setmembership: samples >= 10, box > 0");
   std::string e;  // the bounds command's checks, with its messages
   if (!relax::ValidHorizon(sm.horizon, &e) || !relax::ValidOrder(sm.order, sm.horizon, &e) ||
-      !sdp::ValidSolverName(sm.solver, &e))
+      !relax::ValidBoundsSolver(sm.solver, &e))
     return fail("setmembership: " + e);
   const auto& es = esmaeilani;
   if (es.segments < 1 || es.samples < 20 || es.hold_min < 1 || es.hold_max < es.hold_min || es.grid_f < 2 ||

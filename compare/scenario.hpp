@@ -12,7 +12,7 @@
 //   "noise": {"snr_db": 31} | {"bound": 0.05}     (uniform in [-bound, bound]; plant "hw")
 //            {"std": 0.01}                        (Gaussian; plant "backlash")
 //   "setmembership": {"samples": 100, "horizon": 1, "order": 1, "parameters": ["a1", ...],
-//                     "box": 10 | [[lo, hi], ...], "solver": "sdpa"},
+//                     "box": 10 | [[lo, hi], ...], "solver": "auto"},
 //   "esmaeilani": {"segments": 2, "samples": 300, "hold": [3, 15], "grid_f": 12, "grid_g": 12,
 //                  "max_iterations": 100},
 //   "validation": {"samples": 500, "hold": [1, 10]},
@@ -40,7 +40,7 @@ struct SetMembershipExperiment {
   std::vector<std::string> parameters;  // empty = all (needed for the point estimate's curves)
   std::vector<std::pair<double, double>> box;  // prior box; empty = +-box_half_width
   double box_half_width = 10.0;
-  std::string solver = "sdpa";
+  std::string solver = "auto";
 };
 struct EsmaeilaniExperiment {
   int segments = 2;

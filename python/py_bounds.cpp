@@ -93,7 +93,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   Require([&](std::string* e) { return relax::ValidHorizon(a.horizon, e); });
   if (a.order_given) Require([&](std::string* e) { return relax::ValidOrder(a.options.order, a.horizon, e); });
   a.options.order = a.order_given ? a.options.order : relax::MinimalOrder(a.horizon);
-  Require([&](std::string* e) { return sdp::ValidSolverName(a.options.solver, e); });
+  Require([&](std::string* e) { return relax::ValidBoundsSolver(a.options.solver, e); });
   Require([&](std::string* e) { return relax::ValidThreads(a.options.threads, e); });
   Require([&](std::string* e) { return sdp::ValidExecutorName(a.executor, e); });
   Require([&](std::string* e) { return relax::ValidContractionPasses(a.options.contraction_passes, e); });

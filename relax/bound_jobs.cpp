@@ -38,7 +38,8 @@ nlohmann::json JobOutcome::to_json() const {
           {"sdp_iterations", sdp_iterations}, {"seconds", seconds}, {"moments", moments}, {"blocks", blocks},
           {"working_set", working_set}, {"active_set", active_set}, {"verification", verification}, {"float_bound", float_bound},
           {"correction", correction}, {"verify_seconds", verify_seconds}, {"origin", origin},
-          {"bound_round", bound_round}, {"unfinished", unfinished}};
+          {"bound_round", bound_round}, {"unfinished", unfinished},
+          {"beyond_known_value", beyond_known_value}};
 }
 
 JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
@@ -61,6 +62,7 @@ JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
   o.origin = j.at("origin");
   o.bound_round = j.at("bound_round");
   o.unfinished = j.at("unfinished");
+  o.beyond_known_value = j.value("beyond_known_value", false);
   return o;
 }
 
@@ -167,7 +169,9 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     if (kind == "lp") {
       std::vector<Polynomial> cons = prior_set.sign_constraints(l);
       for (const auto& d : rows_for(prior_set.box(), l)) cons.push_back(d.g);
-      auto solver = sdp::MakeSolver(options.solver == "dsdp" ? "csdp" : options.solver);
+      // An LP: DSDP's LP cone is not used for the screen (its certificates are checked on CSDP's and SDPA's form).
+      const std::string backend = SolverForOrder(options.solver, 1);
+      auto solver = sdp::MakeSolver(backend == "dsdp" ? "csdp" : backend);
       sdp::SdpOptions lp_options = gen_options.sdp;
       lp_options.keep_dual_matrix = false;
       sdp::VerifiedBound cert;
@@ -225,8 +229,13 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     ConstraintGenerationOptions gen = gen_options;
     gen.order = spec.at("d");
     if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
-    auto solver = sdp::MakeSolver(options.solver);
-    auto other = sdp::MakeSolver(other_solver(options.solver));
+    if (spec.contains("stop_beyond")) {  // original units -> this box's scaled units
+      const auto& scaling = set.scaling();
+      gen.stop_beyond = (spec.at("stop_beyond").get<double>() - scaling.center[obj.param]) / scaling.radius[obj.param];
+    }
+    const std::string backend = SolverForOrder(options.solver, gen.order);
+    auto solver = sdp::MakeSolver(backend);
+    auto other = sdp::MakeSolver(other_solver(backend));
     const std::string label = fmt::format("orthant {} {} {} order {}", l, obj.dir < 0 ? "min" : "max",
                                           set.layout().names[obj.param], gen.order);
     auto on_round = [&](const GenerationRound& r) {
@@ -254,6 +263,7 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     out.active_set = r.active_set;
     out.message = r.message;
     out.tight = r.tight;
+    out.beyond_known_value = r.beyond_known_value;
     out.verification = sdp::ToString(r.verification.status);
     out.verify_seconds = r.verification.seconds;
     out.origin = ToString(r.origin);
@@ -339,6 +349,10 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
       spec["max_rounds"] = job.max_rounds;
       key += fmt::format("_r{}", job.max_rounds);
     }
+    if (std::isfinite(job.stop_beyond)) {
+      spec["stop_beyond"] = job.stop_beyond;
+      key += fmt::format("_s{:.17g}", job.stop_beyond);
+    }
     specs.push_back({spec.dump(), key});
     spec_job.push_back(i);
   }
@@ -354,6 +368,7 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
     if (!cached) {
       ++ctx.counters.sdp_jobs;
       ctx.counters.sdp_solves += out.rounds;
+      ctx.counters.jobs_stopped_beyond_witness += out.beyond_known_value ? 1 : 0;
       ctx.counters.solve_seconds += out.seconds;
       ctx.counters.verify_seconds += out.verify_seconds;
       if (out.rounds) ctx.counters.solve_times.push_back(out.seconds / out.rounds);

@@ -7,12 +7,14 @@
 //   {"kind": "witness", "l", "param", "dir", "starts", "rows"}
 //                                                a feasible local extreme of a parameter over orthant l, from the
 //                                                starts in turn, over the data rows `rows` (relax/edge_witness.hpp);
-//   {"kind": "relax", "l", "param", "dir", "d", "box", "rows", "initial", ["max_rounds"]}
+//   {"kind": "relax", "l", "param", "dir", "d", "box", "rows", "initial", ["max_rounds"], ["stop_beyond"]}
 //                                                bound min (dir -1) / max (+1) of a parameter over orthant l at
 //                                                order d in `box`, over the data rows `rows`, starting with blocks
-//                                                for `initial` (indices into rows).
+//                                                for `initial` (indices into rows); it may end once its bound
+//                                                is beyond stop_beyond (a value attained elsewhere).
 // Also here: the engine's context shared by its stages, the run cache, and the dispatcher that reads cached
 // jobs and runs the rest on the executor.
+#include <cmath>
 #include <functional>
 #include <map>
 #include <optional>
@@ -53,6 +55,7 @@ struct JobOutcome {
   std::string origin = "none";     // BoundOrigin: "final round" or "earlier round"
   int bound_round = 0;
   bool unfinished = false;         // the bound is the verified last iterate of a solve that stopped short
+  bool beyond_known_value = false; // ended once its bound passed stop_beyond: valid, cannot move the endpoint
   nlohmann::json to_json() const;
   static JobOutcome from_json(const nlohmann::json& j);
 };
@@ -75,6 +78,7 @@ class RunCache {
 // Counters every stage adds to (they end up in BoundsSummary).
 struct EngineCounters {
   int sdp_jobs = 0, sdp_solves = 0, jobs_from_cache = 0;
+  int jobs_stopped_beyond_witness = 0;  // jobs that ended once their bound passed a certified feasible point's
   double solve_seconds = 0.0, verify_seconds = 0.0;
   std::vector<double> solve_times;  // per SDP solve (job time / rounds)
   std::size_t largest_moments = 0, largest_blocks = 0;
@@ -135,6 +139,9 @@ struct RelaxJob {
   int order = 0;
   std::vector<int> initial;
   int max_rounds = 0;  // 0 = the generation options' limit
+  // A value of the objective's parameter attained by a certified feasible point (relax/edge_witness.hpp): the job
+  // may end once its bound is beyond it (ConstraintGenerationOptions::stop_beyond). NaN: none.
+  double stop_beyond = NAN;
 };
 
 // Runs relaxation jobs (cached ones are read), adds to the counters, reports progress (one step per job), and

@@ -1,6 +1,7 @@
 #include "relax/cheap_pass.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include <fmt/format.h>
@@ -11,9 +12,10 @@ namespace hw::relax {
 namespace {
 
 // One pass: seeds first, then the other objectives from the seeds' blocks. `seed_rows` (data-row indices per
-// orthant) are the blocks the seeds start from.
+// orthant) are the blocks the seeds start from. Seeds always run to convergence (no stop at a witnessed value):
+// the other objectives start from their blocks, so the stops change no job's path but their own.
 PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& settled,
-                        std::vector<OrthantWork>& orthants, int order, int max_rounds, const std::string& phase,
+                        const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants, int order, int max_rounds, const std::string& phase,
                         const std::map<int, std::vector<int>>& seed_rows) {
   PassOutcomes out;
   const int num_objectives = static_cast<int>(objectives.size());
@@ -45,7 +47,7 @@ PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& object
       // The seed's active blocks: its working set less the blocks whose multipliers vanish (they only slow the
       // solves; an objective that needs them gets them back as violated blocks).
       const auto& start = seed_out[k].active_set.empty() ? seed_out[k].working_set : seed_out[k].active_set;
-      rest.push_back({seeds[k].orthant, objectives[j], order, start, max_rounds});
+      rest.push_back({seeds[k].orthant, objectives[j], order, start, max_rounds, StopBeyond(witnessed, j)});
       rest_objective.push_back(j);
     }
   }
@@ -108,9 +110,14 @@ std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<i
   return pos;
 }
 
+double StopBeyond(const std::map<int, double>& witnessed, int j) {
+  const auto it = witnessed.find(j);
+  return it == witnessed.end() ? NAN : it->second;
+}
+
 CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
                              const std::vector<Objective>& objectives, const PassOutcomes& settled,
-                             std::vector<OrthantWork>& orthants) {
+                             const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants) {
   CheapPassResult result;
   std::map<int, std::vector<int>> seed_rows;  // data rows active in the previous pass, per orthant
   for (int pass = 0;; ++pass) {
@@ -118,7 +125,9 @@ CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx
     const std::string phase = contracting ? fmt::format("order {} box contraction {}", options.order, pass + 1)
                                           : fmt::format("order {} relaxations", options.order);
     const int max_rounds = contracting ? std::min(options.contraction_max_rounds, ctx.options.generation.max_rounds) : 0;
-    result.outcomes = RunOnePass(ctx, objectives, settled, orthants, options.order, max_rounds, phase, seed_rows);
+    // A contraction pass wants every bound as tight as its capped rounds allow, so it runs without stops.
+    result.outcomes = RunOnePass(ctx, objectives, settled, contracting ? std::map<int, double>{} : witnessed, orthants,
+                                 options.order, max_rounds, phase, seed_rows);
     if (!contracting) break;
     for (const auto& [key, r] : result.outcomes) {
       const OrthantWork* o = nullptr;

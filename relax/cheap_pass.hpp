@@ -28,10 +28,14 @@ struct CheapPassResult {
 };
 
 // `settled`: objectives already decided per orthant (relax/edge_witness.hpp); they are not solved and their
-// outcomes are returned as given.
+// outcomes are returned as given. `witnessed`: per objective index, a value attained by a certified feasible
+// point (EdgeWitnessResult::witnessed); a job may end once its bound is beyond it.
 CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
                              const std::vector<Objective>& objectives, const PassOutcomes& settled,
-                             std::vector<OrthantWork>& orthants);
+                             const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants);
+
+// The value a job of objective j may stop beyond (NaN: none).
+double StopBeyond(const std::map<int, double>& witnessed, int j);
 
 // Positions in orthant.rows of the given data rows (rows no longer kept are skipped).
 std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<int>& data_rows);

@@ -20,6 +20,7 @@ bool ConstraintGenerationOptions::IsValid(std::string* error) const {
   if (order < 0) return fail("order must be >= 0");
   if (max_rounds < 1) return fail("max_rounds must be >= 1");
   if (add_per_round < 1) return fail("add_per_round must be >= 1");
+  if (block_order_cap < -1) return fail("block_order_cap must be -1 (full order) or >= 0");
   if (!(violation_tolerance > 0)) return fail("violation_tolerance must be > 0");
   if (!(active_fraction >= 0 && active_fraction < 1)) return fail("active_fraction must be in [0, 1)");
   if (!verify.IsValid(error)) return false;
@@ -46,13 +47,13 @@ struct RoundRelaxation {
 };
 
 RoundRelaxation BuildRound(const PolyProblem& core, const std::vector<Polynomial>& candidates,
-                           const std::set<int>& blocks, bool linear_rows_first, int order) {
+                           const std::set<int>& blocks, bool linear_rows_first, int order, int block_order_cap) {
   RoundRelaxation r;
   r.problem = core;
   std::vector<int> orders(core.inequalities.size(), -1);
   for (int i : blocks) {
     r.problem.inequalities.push_back(candidates[i]);
-    orders.push_back(-1);
+    orders.push_back(block_order_cap);
   }
   if (linear_rows_first)
     for (int i = 0; i < static_cast<int>(candidates.size()); ++i)
@@ -69,12 +70,13 @@ RoundRelaxation BuildRound(const PolyProblem& core, const std::vector<Polynomial
 std::pair<std::vector<std::pair<double, int>>, double> ViolatedBlocks(const MomentRelaxation& relaxation,
                                                                      const std::vector<Polynomial>& candidates,
                                                                      const std::set<int>& blocks,
-                                                                     const std::vector<double>& y, double tolerance) {
+                                                                     const std::vector<double>& y, double tolerance,
+                                                                     int block_order_cap) {
   std::vector<std::pair<double, int>> violated;
   double worst = 0.0;
   for (int i = 0; i < static_cast<int>(candidates.size()); ++i) {
     if (blocks.count(i)) continue;
-    const Eigen::MatrixXd L = relaxation.localizing_matrix(candidates[i], y);
+    const Eigen::MatrixXd L = relaxation.localizing_matrix(candidates[i], y, block_order_cap);
     double min_eig;
     if (L.rows() == 1) {
       min_eig = L(0, 0);
@@ -196,7 +198,8 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     result.rounds = round;
     GenerationRound report;
     report.round = round;
-    RoundRelaxation built = BuildRound(core, candidates, blocks, options.linear_rows_first, order);
+    RoundRelaxation built =
+        BuildRound(core, candidates, blocks, options.linear_rows_first, order, options.block_order_cap);
     const MomentRelaxation& relaxation = *built.relaxation;
     report.blocks = static_cast<int>(blocks.size());
     report.linear_rows = built.linear_rows;
@@ -274,6 +277,13 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     } else {
       offer(round, sdp, nullptr, sign);
     }
+    if (best.any && !std::isnan(options.stop_beyond) &&
+        (core.maximize ? best.value <= options.stop_beyond : best.value >= options.stop_beyond)) {
+      announce(-1);
+      result.beyond_known_value = true;
+      return finish(false, fmt::format("round {}: the bound is already beyond a value attained elsewhere, so more "
+                                       "rounds cannot move the extreme", round));
+    }
     const bool solved = sdp.status == sdp::SdpStatus::kOptimal;
     // A round that stops short still points at violated blocks (its last iterate); after two such rounds in a
     // row, or without an iterate, the job ends with the best verified bound so far.
@@ -294,7 +304,8 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     }
     const auto y = relaxation.moments(sdp.y);
     if (solved) result.first_moments.assign(y.begin() + 1, y.begin() + 1 + core.num_vars);
-    const auto [violated, worst] = ViolatedBlocks(relaxation, candidates, blocks, y, options.violation_tolerance);
+    const auto [violated, worst] =
+        ViolatedBlocks(relaxation, candidates, blocks, y, options.violation_tolerance, options.block_order_cap);
     result.max_violation = worst;
     if (!solved && violated.empty()) {  // nothing to add, and the moments of an unfinished solve prove nothing
       announce(0);

@@ -25,12 +25,21 @@ struct ConstraintGenerationOptions {
   // matrix of order 0): implied by its block, so valid, and cheap (one row of the LP block). A candidate gets
   // its full localizing block when that block is violated at the current moments.
   bool linear_rows_first = true;
+  // Mixed orders (the bounded-degree hierarchy's middle ground): a candidate's block is its localizing matrix of
+  // order min(full, block_order_cap); -1 = full order. Any cap relaxes the full order-delta relaxation, so the
+  // bound stays valid; "tight" then means equal to the capped relaxation over every candidate.
+  int block_order_cap = -1;
   // Pass the previous round's moments to backends that take an initial point (SdpOptions::initial_y).
   bool warm_start = true;
   double active_fraction = 1e-4;  // see ConstraintGenerationResult::active_set
   // Between rounds, blocks whose multipliers vanish go back to scalar rows (any subset still gives a valid bound,
   // and the final check covers every omitted block). A block is pruned at most once, so rounds cannot cycle.
   bool prune_inactive = true;
+  // A value the objective is known to attain outside this problem (a certified feasible point of another part of
+  // the set, in scaled units): once the best valid bound is at or beyond it (>= for min, <= for max), this
+  // problem cannot move the extreme over all parts, and the job ends with that bound (`beyond_known_value`).
+  // NaN: no such value, the job runs to convergence.
+  double stop_beyond = NAN;
   sdp::SdpOptions sdp;
   // Verification (sdp/verified_bound.hpp): every round's multiplier gives a rigorous bound, the final round's
   // with re-solves when needed; an infeasibility certificate that does not verify never declares the set empty.
@@ -68,6 +77,7 @@ struct ConstraintGenerationResult {
   bool bound_from_unfinished_solve = false;  // that round's solve stopped short (pFEAS, iteration limit, ...)
   double primal_value = 0.0;
   bool tight = false;        // true: no omitted block is violated, so bound == full relaxation's bound
+  bool beyond_known_value = false;  // ended early: the bound already reached options.stop_beyond
   double max_violation = 0.0;  // largest relative violation among omitted blocks at the last checked round
   int rounds = 0;
   std::vector<int> working_set;  // candidates with a block in the last LMI

@@ -88,6 +88,28 @@ double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>
   return m;
 }
 
+std::map<int, double> WitnessedExtremes(const HwOuterSet& set, const std::vector<Objective>& objectives,
+                                        const std::vector<OrthantWork>& orthants,
+                                        const std::map<ObjectiveKey, std::vector<double>>& points) {
+  std::map<int, double> extremes;
+  for (const auto& [key, p] : points) {
+    const OrthantWork* w = nullptr;
+    for (const auto& o : orthants)
+      if (o.index == key.first) w = &o;
+    if (!w || w->empty() || p.size() != w->box.size()) continue;
+    bool inside = true;
+    for (std::size_t i = 0; i < p.size(); ++i) inside = inside && w->box[i].first <= p[i] && p[i] <= w->box[i].second;
+    if (!inside || !(CertifiedMinSlack(set, key.first, p) >= 0)) continue;
+    for (std::size_t j = 0; j < objectives.size(); ++j) {
+      const double v = p[objectives[j].param];
+      const auto it = extremes.find(static_cast<int>(j));
+      if (it == extremes.end() || (objectives[j].dir < 0 ? v < it->second : v > it->second))
+        extremes[static_cast<int>(j)] = v;
+    }
+  }
+  return extremes;
+}
+
 namespace {
 
 std::string WitnessSpec(const OrthantWork& w, const Objective& o, const std::vector<std::vector<double>>& starts) {
@@ -184,6 +206,7 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
     if (o.dir < 0 ? p[o.param] < current[o.param] : p[o.param] > current[o.param]) current = p;
   }
 
+  if (options.stop_beyond_witnesses) result.witnessed = WitnessedExtremes(set, objectives, orthants, found);
   // Certification here, whatever the workers said: the point must attain the edge and satisfy every row.
   std::map<int, int> edge_reached_in;  // objective -> orthant whose point attains the prior box edge
   for (const auto& [key, point] : found) {

@@ -26,6 +26,10 @@ struct EdgeWitnessResult {
   // the box edge"), and in the other live orthants ("skipped": the interval already reaches the box edge).
   std::map<ObjectiveKey, JobOutcome> settled;
   std::map<ObjectiveKey, std::vector<double>> points;  // the witness of each settling orthant (original units)
+  // Per objective index: the most extreme value of its parameter over every certified feasible point found (in
+  // any live orthant, inside its box). The endpoint is at least that extreme, so an orthant whose valid bound
+  // is already beyond it cannot move the endpoint (relax/constraint_generation.hpp, stop_beyond).
+  std::map<int, double> witnessed;
   int local_solves = 0;
   double seconds = 0.0;
 };
@@ -33,6 +37,12 @@ struct EdgeWitnessResult {
 // The smallest slack of the inequalities of orthant l (sign and data rows, unscaled) at p, each lowered by a
 // bound on its floating-point evaluation error; >= 0 means p lies in D^ss(n) of orthant l despite rounding.
 double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>& p);
+
+// Per objective, the most extreme value of its parameter over the points that are certified feasible points of
+// their orthant (inside the orthant's box, CertifiedMinSlack >= 0); objectives without one are absent.
+std::map<int, double> WitnessedExtremes(const HwOuterSet& set, const std::vector<Objective>& objectives,
+                                        const std::vector<OrthantWork>& orthants,
+                                        const std::map<ObjectiveKey, std::vector<double>>& points);
 
 EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
                                          const std::vector<Objective>& objectives,

@@ -14,6 +14,9 @@ struct EdgeWitnessOptions {
   int random_starts = 3;  // deterministic starts in the orthant's box when no feasible point is known yet
   // A witness attains the edge when |p_k - edge| <= edge_tolerance * box width (it is then moved onto it).
   double edge_tolerance = 1e-8;
+  // Relaxation jobs end once their bound passes the value a certified feasible point attains (in any orthant):
+  // such a bound cannot move the endpoint (EdgeWitnessResult::witnessed). Off: every job runs to convergence.
+  bool stop_beyond_witnesses = true;
   InnerPointOptions local;
   bool IsValid(std::string* error) const;
 };

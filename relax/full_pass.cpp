@@ -9,7 +9,8 @@ namespace hw::relax {
 
 PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, const std::vector<Objective>& objectives,
                          const std::vector<int>& wanted_objectives, const PassOutcomes& cheap,
-                         const PassOutcomes& settled, std::vector<OrthantWork>& orthants) {
+                         const PassOutcomes& settled, const std::map<int, double>& witnessed,
+                         std::vector<OrthantWork>& orthants) {
   PassOutcomes full;
   std::vector<double> current(objectives.size(), NAN);  // aggregated endpoint of the finished full-order jobs
   std::map<int, std::set<int>> active_rows;              // per orthant: data rows active at full order so far
@@ -36,7 +37,10 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
         const auto& c = cheap.at({w.index, o});
         // A failed cheap job cannot be used to skip: it must be solved.
         const double v = c.status == "solved" ? c.bound : (dir < 0 ? -INFINITY : INFINITY);
-        const bool can_move = std::isnan(current[o]) || (dir < 0 ? v < current[o] : v > current[o]);
+        // The endpoint is at least as extreme as the finished jobs' bounds and as a witnessed value.
+        const double witness = StopBeyond(witnessed, o);
+        const bool can_move = (std::isnan(current[o]) || (dir < 0 ? v < current[o] : v > current[o])) &&
+                              (std::isnan(witness) || (dir < 0 ? v < witness : v > witness));
         if (!can_move) continue;
         if (!best || (dir < 0 ? v < best_val : v > best_val)) {
           best = &w;
@@ -46,7 +50,8 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
       if (!best) continue;
       std::set<int> rows(active_rows[best->index]);
       for (int r : RowsOfWorkingSet(*best, cheap.at({best->index, o}).working_set)) rows.insert(r);
-      wave.push_back({best, objectives[o], options.order, PositionsOfRows(*best, {rows.begin(), rows.end()}), 0});
+      wave.push_back({best, objectives[o], options.order, PositionsOfRows(*best, {rows.begin(), rows.end()}), 0,
+                      StopBeyond(witnessed, o)});
       wave_objective.push_back(o);
     }
     if (wave.empty()) break;
@@ -54,7 +59,9 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
     for (std::size_t i = 0; i < wave.size(); ++i) {
       const int l = wave[i].orthant->index, o = wave_objective[i];
       full[{l, o}] = outs[i];
-      for (int r : RowsOfWorkingSet(*wave[i].orthant, outs[i].working_set)) active_rows[l].insert(r);
+      // A job that stopped at a witnessed value has not converged: its blocks are no warm start for later waves.
+      if (!outs[i].beyond_known_value)
+        for (int r : RowsOfWorkingSet(*wave[i].orthant, outs[i].working_set)) active_rows[l].insert(r);
       if (outs[i].status == "solved") {
         const int dir = objectives[o].dir;
         if (std::isnan(current[o]) || (dir < 0 ? outs[i].bound < current[o] : outs[i].bound > current[o]))

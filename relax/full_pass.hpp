@@ -18,9 +18,11 @@ struct FullPassOptions {
 
 // Outcomes at full order for the wanted objectives; orthants skipped keep their cheap outcome with status
 // "skipped" (its bound is valid and cannot move the interval). `settled` outcomes (relax/edge_witness.hpp) are
-// exact at every order and are returned as given.
+// exact at every order and are returned as given; `witnessed` values (see RunCheapPass) let jobs end early and
+// skip orthants whose cheap bound is already beyond them.
 PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, const std::vector<Objective>& objectives,
                          const std::vector<int>& wanted_objectives, const PassOutcomes& cheap,
-                         const PassOutcomes& settled, std::vector<OrthantWork>& orthants);
+                         const PassOutcomes& settled, const std::map<int, double>& witnessed,
+                         std::vector<OrthantWork>& orthants);
 
 }  // namespace hw::relax

@@ -291,8 +291,10 @@ int MomentRelaxation::full_localizing_order(const Polynomial& g) const {
   return order_ - ceil_half(std::max(0, g.degree()));
 }
 
-Eigen::MatrixXd MomentRelaxation::localizing_matrix(const Polynomial& g, const std::vector<double>& y) const {
-  const int k = full_localizing_order(g);
+Eigen::MatrixXd MomentRelaxation::localizing_matrix(const Polynomial& g, const std::vector<double>& y,
+                                                    int max_order) const {
+  const int full = full_localizing_order(g);
+  const int k = max_order >= 0 && full >= 0 ? std::min(full, max_order) : full;
   if (k < 0) throw std::invalid_argument("localizing_matrix: constraint degree exceeds 2 * order");
   const int size = static_cast<int>(MonomialBasis::count(index_.basis().num_vars(), k));
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(size, size);

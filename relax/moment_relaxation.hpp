@@ -76,9 +76,9 @@ class MomentRelaxation {
   // Moment matrix M_k(y) for k <= order.
   Eigen::MatrixXd moment_matrix(const std::vector<double>& moments, int k) const;
   double objective_sign() const { return sign_; }  // +1 for min, -1 for max (the LMI always minimises)
-  // Localizing matrix M_{order - ceil(deg g / 2)}(g y) at a full moment vector (for checking constraints
-  // that were left out of the LMI).
-  Eigen::MatrixXd localizing_matrix(const Polynomial& g, const std::vector<double>& moments) const;
+  // Localizing matrix M_k(g y), k = order - ceil(deg g / 2) capped at max_order (-1: no cap), at a full moment
+  // vector (for checking constraints that were left out of the LMI).
+  Eigen::MatrixXd localizing_matrix(const Polynomial& g, const std::vector<double>& moments, int max_order = -1) const;
   // The full localizing order of g in this relaxation: order - ceil(deg g / 2).
   int full_localizing_order(const Polynomial& g) const;
   // The LMI block of each of the problem's inequalities (box constraints after them); -1 for the scalar ones,

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
 #include "relax/aggregate.hpp"
@@ -44,10 +45,18 @@ BoundsOptions EngineOptions(const BoundsOptions& options) {
   return opts;
 }
 
+// The backend of each relaxation order up to the run's order (index 0: order 1).
+std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
+  std::vector<std::string> backends;
+  for (int d = 1; d <= options.order; ++d) backends.push_back(SolverForOrder(options.solver, d));
+  return backends;
+}
+
 // Everything that changes the numbers, hashed into the run directory's name.
 std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nlohmann::json* meta) {
   *meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
-           {"cheap_pass", options.cheap_pass}, {"solver", options.solver}, {"box", set.box()},
+           {"cheap_pass", options.cheap_pass}, {"solver", options.solver}, {"backends", BackendsByOrder(options)},
+           {"box", set.box()},
            {"violation_tolerance", options.generation.violation_tolerance},
            {"gap_tolerance", options.generation.sdp.gap_tolerance}, {"verify", options.generation.verify.enabled},
            {"linear_rows_first", options.generation.linear_rows_first},
@@ -55,7 +64,9 @@ std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nloh
            {"row_reduction", options.reduction.enabled},
            {"contraction_passes", options.contraction_passes},
            {"contraction_min_shrink", options.contraction_min_shrink},
-           {"contraction_max_rounds", options.contraction_max_rounds}};
+           {"contraction_max_rounds", options.contraction_max_rounds},
+           {"stop_beyond_witnesses", options.edge_witness.stop_beyond_witnesses},
+           {"block_order_cap", options.generation.block_order_cap}};
   uint64_t h = 1469598103934665603ull;
   auto mix = [&h](const std::string& t) {
     for (unsigned char c : t) h = (h ^ c) * 1099511628211ull;
@@ -112,13 +123,25 @@ bool ValidContractionPasses(int passes, std::string* error) {
   return Fail(error, fmt::format("contraction_passes {} is out of range 0..10 (0 = no box contraction)", passes));
 }
 
+bool ValidBoundsSolver(const std::string& name, std::string* error) {
+  if (name == "auto") return true;
+  if (sdp::ValidSolverName(name, nullptr)) return true;
+  return Fail(error, fmt::format("solver '{}' unknown; expected auto (the backend per relaxation order), {}", name,
+                                 fmt::join(sdp::AvailableSolvers(), ", ")));
+}
+
+std::string SolverForOrder(const std::string& name, int order) {
+  if (name != "auto") return name;
+  return order <= 2 ? "csdp" : "dsdp";
+}
+
 bool BoundsOptions::IsValid(std::string* error) const {
   auto fail = [&](std::string m) { return Fail(error, std::move(m)); };
   if (order < 1 || order > kMaxOrder) return fail(fmt::format("order {} is out of range 1..{}", order, kMaxOrder));
   if (!ValidThreads(threads, error) || !ValidContractionPasses(contraction_passes, error)) return false;
   if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
   if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
-  if (!sdp::ValidSolverName(solver, error)) return false;
+  if (!ValidBoundsSolver(solver, error)) return false;
   if (!reduction.IsValid(error)) return false;
   if (!edge_witness.IsValid(error)) return false;
   return generation.IsValid(error);
@@ -145,6 +168,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["order"] = order;
   j["horizon"] = horizon;
   j["solver"] = solver;
+  j["solver_option"] = solver_option;
   j["executor"] = executor;
   nlohmann::json box_j = nlohmann::json::array();
   for (std::size_t i = 0; i < box.size(); ++i)
@@ -167,6 +191,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["counts"] = {{"orthants_total", orthants_total}, {"orthants_proven_empty", orthants_empty},
                  {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
                  {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache},
+                 {"jobs_stopped_beyond_witness", jobs_stopped_beyond_witness},
                  {"edge_witness_settled", edge_witness_settled}, {"edge_witness_solves", edge_witness_solves}};
   j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds},
                  {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds},
@@ -255,12 +280,12 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   // 4. Cheap pass (with box contraction when asked).
   CheapPassOptions cheap_options{cheap_order, options.contraction_passes, options.contraction_min_shrink,
                                  options.contraction_max_rounds};
-  const CheapPassResult cheap = RunCheapPass(cheap_options, ctx, objectives, edges.settled, orthants);
+  const CheapPassResult cheap = RunCheapPass(cheap_options, ctx, objectives, edges.settled, edges.witnessed, orthants);
   // 5. Full pass.
   PassOutcomes full = cheap.outcomes;
   if (options.order > cheap_order)
     full = RunFullPass(FullPassOptions{options.order, cheap_order}, ctx, objectives, wanted_objectives, cheap.outcomes,
-                       edges.settled, orthants);
+                       edges.settled, edges.witnessed, orthants);
   // 6. Aggregate.
   const AggregateResult agg = AggregateIntervals(
       AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,
@@ -273,7 +298,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.contraction_passes_run = cheap.contraction_passes_run;
   summary.order = options.order;
   summary.horizon = set.horizon();
-  summary.solver = options.solver;
+  summary.solver = SolverForOrder(options.solver, options.order);
+  summary.solver_option = options.solver;
   summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
   summary.box = set.box();
   summary.parameter_names = set.layout().names;
@@ -299,6 +325,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.sdp_jobs = counters.sdp_jobs;
   summary.sdp_solves = counters.sdp_solves;
   summary.jobs_from_cache = counters.jobs_from_cache;
+  summary.jobs_stopped_beyond_witness = counters.jobs_stopped_beyond_witness;
   summary.solve_seconds = counters.solve_seconds;
   summary.verify_seconds = counters.verify_seconds;
   summary.largest_moments = counters.largest_moments;

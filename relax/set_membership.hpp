@@ -34,7 +34,8 @@ struct BoundsOptions {
   int order = 3;                 // delta of the reported intervals
   bool cheap_pass = true;        // solve the minimal order first to skip objectives (recommended)
   bool lp_screen = true;
-  std::string solver = "sdpa";   // "csdp", "sdpa" or "dsdp"
+  // "auto" (the backend per relaxation order, SolverForOrder), "csdp", "sdpa" or "dsdp".
+  std::string solver = "auto";
   bool retry_with_other_solver = true;  // a failed solve is repeated with the other backend (CSDP <-> SDPA; DSDP -> CSDP)
   // Local parallel jobs. CSDP and SDPA are not thread-safe, so jobs run in forked worker processes
   // (sdp::ForkExecutor); 0 = one per core. Ignored when `executor` is set.
@@ -104,6 +105,7 @@ struct BoundsSummary {
   int sdp_jobs = 0;           // relaxation jobs run (cached ones excluded)
   int sdp_solves = 0;         // SDP solves including constraint-generation rounds
   int jobs_from_cache = 0;
+  int jobs_stopped_beyond_witness = 0;  // ended early: their bound passed a certified feasible point's value
   int edge_witness_settled = 0;  // (orthant, objective) pairs settled by a feasible point at the box edge
   int edge_witness_solves = 0;   // local optimisations run to find them
   double edge_witness_seconds = 0.0;
@@ -112,7 +114,8 @@ struct BoundsSummary {
   std::size_t largest_moments = 0, largest_blocks = 0;
   double wall_seconds = 0.0;
   int order = 0, horizon = 0;
-  std::string solver;
+  std::string solver;          // the backend of the reported order's relaxations
+  std::string solver_option;   // as asked: "auto" or a backend name
   std::string executor;       // e.g. "fork (2 workers)"
   bool worker_rank = false;   // true on MPI worker ranks: they served jobs and hold no result
   std::vector<std::pair<double, double>> box;
@@ -143,6 +146,11 @@ bool ValidOrder(int order, int horizon, std::string* error);
 bool ValidThreads(int threads, std::string* error);
 // Cheap passes in contracted boxes: 0 (no contraction)..10.
 bool ValidContractionPasses(int passes, std::string* error);
+// The backend of a bounds run: "auto" or a name of sdp::AvailableSolvers().
+bool ValidBoundsSolver(const std::string& name, std::string* error);
+// The backend that solves relaxations of this order: `name` itself, or for "auto" the one measured fastest on
+// the engine's relaxations (docs/sdp.md): CSDP up to order 2, DSDP from order 3 on.
+std::string SolverForOrder(const std::string& name, int order);
 
 BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                             const std::function<void(const BoundsProgress&)>& progress = {});

@@ -191,7 +191,7 @@ TEST_F(CliIo, HelpShowsDefaultsAndTheVerifyPair) {
   EXPECT_TRUE(Has(r.output, "--no-verify")) << r.output;
   EXPECT_TRUE(Has(r.output, "TEXT=poly:3")) << r.output;  // --input-basis
   EXPECT_TRUE(Has(r.output, "=minimal")) << r.output;     // --order
-  EXPECT_TRUE(Has(r.output, "=sdpa")) << r.output;        // --solver
+  EXPECT_TRUE(Has(r.output, "=auto")) << r.output;        // --solver
   EXPECT_TRUE(Has(r.output, "Exit status")) << r.output;
   EXPECT_TRUE(Has(r.output, "3 model invalidated")) << r.output;
   const auto both = Cli(Bounds("--verify --no-verify"));

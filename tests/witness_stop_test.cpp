@@ -1,0 +1,128 @@
+// Jobs that end once their bound passes a value a certified feasible point attains (ConstraintGenerationOptions::
+// stop_beyond, relax/edge_witness.hpp WitnessedExtremes): the bound they report stays valid, the value only
+// comes from points that are certified, and a run with the stops gives the endpoints of a run without them.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "core/cerone_example.hpp"
+#include "relax/constraint_generation.hpp"
+#include "relax/edge_witness.hpp"
+#include "relax/set_membership.hpp"
+
+namespace hw::relax {
+namespace {
+
+HwOuterSet SeededSet(uint64_t seed, int samples, int horizon, double snr_db) {
+  const auto ex = SimulateCeroneExample(seed, samples, snr_db);
+  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  return HwOuterSet(CeroneExampleStructure(), data, horizon, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+}
+
+// min / max of parameter k over orthant l by constraint generation over every data row, at order 2.
+ConstraintGenerationResult Solve(const HwOuterSet& set, int l, int k, bool maximize, double stop_beyond) {
+  PolyProblem core;
+  core.num_vars = set.num_vars();
+  core.objective = Polynomial::Variable(set.num_vars(), k);
+  core.maximize = maximize;
+  core.inequalities = set.box_constraints();
+  for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(g);
+  std::vector<Polynomial> candidates;
+  for (const auto& d : set.data_constraints(l)) candidates.push_back(d.g);
+  ConstraintGenerationOptions o;
+  o.order = 2;
+  o.stop_beyond = stop_beyond;
+  o.sdp.acceptable_gap = 1e-5;
+  o.sdp.infeasibility_tolerance = 0.5;
+  auto solver = sdp::MakeSolver("csdp");
+  return SolveWithConstraintGeneration(o, core, candidates, {}, *solver);
+}
+
+TEST(WitnessStop, AJobEndsOnceItsVerifiedBoundPassesTheValueAndTheBoundStaysValid) {
+  const HwOuterSet set = SeededSet(3, 30, 1, 31.0);
+  const auto truth = CeroneExample::TrueParameters();
+  const int l = set.orthant_of(truth);
+  const int a1 = 4;
+  for (const bool maximize : {false, true}) {
+    const double dir = maximize ? -1.0 : 1.0;  // +1: a lower bound (min)
+    const auto full = Solve(set, l, a1, maximize, NAN);
+    ASSERT_EQ(full.status, RelaxationStatus::kSolved);
+    ASSERT_GT(full.rounds, 1) << "the instance no longer needs several rounds";
+    EXPECT_FALSE(full.beyond_known_value);
+    // A value far inside the relaxation's bound (below it for min): an early round's bound passes it.
+    const double inside = full.bound - dir * 0.5;
+    const auto early = Solve(set, l, a1, maximize, inside);
+    ASSERT_EQ(early.status, RelaxationStatus::kSolved);
+    EXPECT_TRUE(early.beyond_known_value);
+    EXPECT_LT(early.rounds, full.rounds);
+    EXPECT_GE(dir * early.bound, dir * inside);
+    // Still a bound of the full relaxation (a subset of its inequalities): never past the converged one.
+    EXPECT_LE(dir * early.bound, dir * full.bound + 1e-7);
+    EXPECT_TRUE(early.verification.verified());
+    // A value the relaxation never reaches: the job runs to convergence, same bound.
+    const auto unreached = Solve(set, l, a1, maximize, full.bound + dir * 0.5);
+    EXPECT_FALSE(unreached.beyond_known_value);
+    EXPECT_EQ(unreached.rounds, full.rounds);
+    EXPECT_DOUBLE_EQ(unreached.bound, full.bound);
+  }
+}
+
+TEST(WitnessStop, OnlyCertifiedPointsInsideTheirOrthantsBoxGiveValues) {
+  const HwOuterSet set = SeededSet(5, 60, 2, 31.0);
+  const auto truth = CeroneExample::TrueParameters();
+  const int l = set.orthant_of(truth);
+  std::vector<Objective> objectives;
+  for (int k = 0; k < set.num_vars(); ++k) objectives.push_back({k, -1}), objectives.push_back({k, +1});
+  OrthantWork w;
+  w.index = l;
+  w.box = set.box();
+  auto far = truth;
+  far[4] = 9.0;  // a1 far from every point that explains the data: not certified
+  const auto extremes = WitnessedExtremes(set, objectives, {w}, {{{l, 0}, truth}, {{l, 1}, far}});
+  ASSERT_EQ(extremes.size(), objectives.size());
+  for (std::size_t j = 0; j < objectives.size(); ++j) EXPECT_EQ(extremes.at(j), truth[objectives[j].param]);
+  // A box that leaves the truth out (a contracted box of the orthant): its point says nothing there.
+  w.box[4] = {0.0, 1.0};
+  EXPECT_TRUE(WitnessedExtremes(set, objectives, {w}, {{{l, 0}, truth}}).empty());
+  // A point claimed for another orthant is checked against that orthant's inequalities.
+  OrthantWork other = w;
+  other.index = l ^ 1;
+  other.box = set.box();
+  EXPECT_TRUE(WitnessedExtremes(set, objectives, {other}, {{{l ^ 1, 0}, truth}}).empty());
+}
+
+TEST(WitnessStop, TheEngineGivesTheEndpointsOfARunWithoutStops) {
+  // Horizon 1, order 2: small jobs. The seed of each orthant (min alpha2) never stops, so the stops change no
+  // path but the stopped jobs' own: the endpoints are the same numbers.
+  const HwOuterSet set = SeededSet(7, 40, 1, 31.0);
+  BoundsOptions options;
+  options.order = 2;
+  options.threads = 2;
+  options.solver = "csdp";
+  options.parameters = {"alpha2", "b1"};
+  const BoundsSummary with = ComputeBounds(options, set);
+  options.edge_witness.stop_beyond_witnesses = false;
+  const BoundsSummary without = ComputeBounds(options, set);
+  ASSERT_GT(with.jobs_stopped_beyond_witness, 0) << "the instance no longer exercises the stops";
+  EXPECT_EQ(without.jobs_stopped_beyond_witness, 0);
+  EXPECT_LT(with.sdp_solves, without.sdp_solves);
+  const auto truth = CeroneExample::TrueParameters();
+  ASSERT_EQ(with.intervals.size(), without.intervals.size());
+  for (std::size_t i = 0; i < with.intervals.size(); ++i) {
+    const auto& a = with.intervals[i];
+    const auto& b = without.intervals[i];
+    const std::size_t k = std::find(with.parameter_names.begin(), with.parameter_names.end(), a.name) -
+                          with.parameter_names.begin();
+    for (const auto& [x, y] : {std::pair{a.lower, b.lower}, std::pair{a.upper, b.upper}}) {
+      EXPECT_EQ(x.status, "guaranteed") << a.name;
+      EXPECT_EQ(x.verification, "verified") << a.name;
+      EXPECT_NEAR(x.value, y.value, 1e-9 * (1 + std::abs(y.value))) << a.name;
+    }
+    EXPECT_LE(a.lower.value, truth[k]) << a.name;
+    EXPECT_GE(a.upper.value, truth[k]) << a.name;
+  }
+}
+
+}  // namespace
+}  // namespace hw::relax
