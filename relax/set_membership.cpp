@@ -230,9 +230,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   const RunCache cache(options.run_dir, ProblemKey(options, set, &meta), meta);
   EngineCounters counters;
   ProgressReporter reporter(progress);
-  if (const int stored = cache.stored_jobs(); stored > 0)
-    reporter.Message(fmt::format("resuming: {} finished jobs from {}; each phase counts only the jobs still to run",
-                                 stored, cache.path()));
+  if (const auto line = cache.resume_line()) reporter.Message(*line);
   EngineContext ctx{options, set, *executor, job, cache, counters, reporter};
 
   // 1. Screen orthants.
