@@ -65,11 +65,6 @@ std::vector<double> parse_list(const std::string& text, const std::string& what)
 // Exit status of a run whose data prove that no parameter in the prior box fits (README, `bounds --help`).
 constexpr int kExitInvalidated = 3;
 
-// True when every sign orthant is proven empty by a certificate: D^ss(n) within the prior box is empty, so
-// no parameter in the box explains the data within the noise bound.
-// (To be replaced by BoundsSummary::invalidated() when the engine provides it.)
-bool ModelInvalidated(const relax::BoundsSummary& s) { return s.orthants_total > 0 && s.orthants_empty == s.orthants_total; }
-
 struct BoundsCliOptions {
   std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
   std::string solver = "sdpa", json_out, run_dir, truth, executor = "fork";
@@ -169,6 +164,15 @@ bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::
   return covered;
 }
 
+// How one orthant was proven empty, for a person: "LP screen, verified in interval arithmetic".
+std::string CertificateText(const relax::EmptinessCertificate& c) {
+  const std::string how = c.kind == "lp"               ? "LP screen infeasible"
+                          : c.kind == "relaxation"     ? fmt::format("order {} relaxation infeasible", c.order)
+                                                       : fmt::format("order {} bounds cross", c.order);
+  return fmt::format("{}{}, {}", how, c.contracted_box ? " in the contracted box" : "",
+                     c.verified ? "verified in interval arithmetic" : "the solver's floating-point certificate (unverified)");
+}
+
 // The verdict of an empty feasible set: what it means, which certificates prove it, where to look next.
 void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptions& o) {
   fmt::print("\nVERDICT: model invalidated. No parameter in the prior box explains the data within the noise bound: "
@@ -176,16 +180,17 @@ void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptio
              "wrong.\n",
              o.na, o.nb, o.input_basis, o.output_basis, o.horizon);
   std::map<std::string, int> by_certificate;
-  for (const auto& r : summary.orthants) ++by_certificate[r.status];
-  fmt::print("certificates: all {} sign orthants are proven empty ({}), each {}:\n", summary.orthants_total,
-             [&] {
-               std::string c;
-               for (const auto& [kind, n] : by_certificate) c += fmt::format("{}{} {}", c.empty() ? "" : ", ", n, kind);
-               return c;
-             }(),
-             o.no_verify ? "by the solver's floating-point certificate (--no-verify)"
-                         : "by a certificate verified in interval arithmetic");
-  for (const auto& r : summary.orthants) fmt::print("  orthant {:>3} ({}): {}\n", r.index, r.signs, r.status);
+  int verified = 0;
+  for (const auto& r : summary.orthants) {
+    ++by_certificate[r.status];
+    verified += r.certificate && r.certificate->verified ? 1 : 0;
+  }
+  std::string counts;
+  for (const auto& [kind, n] : by_certificate) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, kind);
+  fmt::print("certificates: all {} sign orthants are proven empty ({}); {} of them verified in interval arithmetic{}:\n",
+             summary.orthants_total, counts, verified, o.no_verify ? " (--no-verify)" : "");
+  for (const auto& r : summary.orthants)
+    fmt::print("  orthant {:>3} ({}): {}\n", r.index, r.signs, r.certificate ? CertificateText(*r.certificate) : r.status);
   fmt::print("next: `hwbounds diagnose --data REC --validate REC2 --fit hw:NA,NB,PIN,POUT` looks for what the model "
              "leaves out (docs/diagnose.md); a larger noise bound, other bases or orders, or a wider --box change the "
              "question.\n");
@@ -246,22 +251,12 @@ void PrintWarnings(const relax::BoundsSummary& summary, bool verify) {
 // The result JSON; an invalidated model has "invalidated": true and null interval values.
 nlohmann::json ResultJson(const relax::BoundsSummary& summary, const BoundsCliOptions& o, const relax::HwOuterSet& set,
                           const std::vector<double>& truth, bool covered) {
-  auto j = summary.to_json();
-  const bool invalidated = ModelInvalidated(summary);
-  j["invalidated"] = invalidated;
-  if (invalidated) {
-    j["verdict"] = "no parameter in the prior box explains the data within the noise bound: the model class or the "
-                   "noise bound is wrong";
-    for (auto& iv : j["intervals"]) {
-      iv["half_width"] = nullptr;
-      for (const char* side : {"lower", "upper"}) iv[side]["value"] = nullptr;
-    }
-  }
+  auto j = summary.to_json();  // "invalidated", the verdict, null intervals and each orthant's certificate
   j["data"] = o.data;
   j["data_warnings"] = set.warnings();
   j["structure"] = {{"na", o.na}, {"nb", o.nb}, {"proper", o.proper}, {"input_basis", o.input_basis},
                     {"output_basis", o.output_basis}};
-  if (!truth.empty() && !invalidated) {
+  if (!truth.empty() && !summary.invalidated()) {
     j["truth"] = truth;
     j["truth_covered"] = covered;
   }
@@ -360,7 +355,7 @@ void AddBoundsCommand(CLI::App& app) {
                  p.elapsed_seconds, p.eta_seconds);
     };
     const auto summary = relax::ComputeBounds(options, set, progress);
-    const bool invalidated = ModelInvalidated(summary);
+    const bool invalidated = summary.invalidated();
     bool covered = true;
     if (invalidated) PrintInvalidation(summary, *o);
     else covered = PrintIntervals(summary, names, truth);

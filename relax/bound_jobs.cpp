@@ -407,7 +407,8 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
     ctx.counters.largest_blocks = std::max(ctx.counters.largest_blocks, out.blocks);
     if (out.status == "infeasible") {
       OrthantWork& o = orthants.at(static_cast<std::size_t>(&*jobs[i].orthant - orthants.data()));
-      if (!o.empty()) o.status = fmt::format("empty (order {}{})", jobs[i].order, o.box != ctx.set.box() ? ", contracted box" : "");
+      if (!o.empty())
+        o.ProveEmpty({"relaxation", jobs[i].order, o.box != ctx.set.box(), out.verification == "verified"});
     }
     ctx.progress.Done();
   });

@@ -138,7 +138,12 @@ struct OrthantWork {
   std::vector<int> rows;
   std::vector<nlohmann::json> reduction;  // per step: {"step", "rows", "kept"} (JSON of RowGroupCount)
   std::string status = "undecided";       // or "empty (...)": the certificate that proved it empty
+  std::optional<EmptinessCertificate> certificate;  // set with the status by ProveEmpty
   bool empty() const { return status.rfind("empty", 0) == 0; }
+  void ProveEmpty(const EmptinessCertificate& c) {
+    certificate = c;
+    status = c.status();
+  }
 };
 
 // One relaxation job: objective over an orthant at an order, with blocks for `initial` (indices into rows).
