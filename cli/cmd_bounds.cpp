@@ -18,7 +18,8 @@
 namespace hw::cli {
 namespace {
 
-// "--box -10,10" (all parameters) or "--box a1=0,3 --box b1=-5,5" (named); later entries win.
+// "--box -10,10" (all parameters) or "--box a1=0,3 --box b1=-5,5" (named); later entries win. The text's syntax
+// is checked here, the values by the library's ValidBoxEntry (the Python module's box gets the same message).
 std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>& specs,
                                                  const std::vector<std::string>& names) {
   std::vector<std::pair<double, double>> box(names.size(), {-10.0, 10.0});
@@ -31,19 +32,12 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
     double lo = 0, hi = 0;
     char comma = 0;
     std::istringstream in(range);
-    if (!(in >> lo >> comma >> hi) || comma != ',' || !(lo < hi))
-      throw InputError(fmt::format("--box '{}': expected LO,HI with LO < HI, or NAME=LO,HI", spec));
-    bool found = target.empty();
+    if (!(in >> lo >> comma >> hi) || comma != ',' || !(in >> std::ws).eof())
+      throw InputError(fmt::format("--box '{}': expected LO,HI (every parameter) or NAME=LO,HI", spec));
+    RequireOption(fmt::format("--box '{}'", spec),
+                  [&](std::string* e) { return relax::ValidBoxEntry(target, lo, hi, names, e); });
     for (std::size_t i = 0; i < names.size(); ++i)
-      if (target.empty() || names[i] == target) {
-        box[i] = {lo, hi};
-        found = true;
-      }
-    if (!found) {
-      std::string all;
-      for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
-      throw InputError(fmt::format("--box '{}': no parameter '{}'; the parameters are: {}", spec, target, all));
-    }
+      if (target.empty() || names[i] == target) box[i] = {lo, hi};
   }
   return box;
 }
