@@ -392,59 +392,60 @@ void ParseDiagnoseRecordingSpec(const std::string& text) {
     if (name->empty() || name->find(',') != std::string::npos) throw std::logic_error("column name '" + *name + "'");
 }
 
+// One text parser: half its inputs are edits of a valid seed (over `alphabet`), a quarter random text over it (either
+// outcome), a quarter invalid by construction (`invalid(seed)` lists such texts; each must be rejected).
+struct TextTarget {
+  std::string name;
+  std::vector<std::string> seeds;
+  std::string alphabet;
+  std::function<std::vector<std::string>(const std::string& seed)> invalid;
+  std::function<void(const std::string&)> parse;
+};
+
+void FuzzText(Mutator& m, const TextTarget& target, int inputs) {
+  Harness h(target.name, inputs);
+  for (int i = 0; i < inputs; ++i) {
+    const std::string seed = m.Pick(target.seeds);
+    if (i % 4 < 2) h.Feed(m.Text(seed, target.alphabet, m.Int(1, 3)), Expect::kEither, target.parse);
+    else if (i % 4 == 2) h.Feed(m.Random(target.alphabet, m.Int(0, 30)), Expect::kEither, target.parse);
+    else h.Feed(m.Pick(target.invalid(seed)), Expect::kInvalid, target.parse);
+  }
+}
+
 TEST(ParserFuzz, DiagnoseTexts) {
   constexpr int kInputs = 3000;
   Mutator m(4);
-  {
-    Harness h("diagnose --fit", kInputs);
-    const std::vector<std::string> seeds = {"linear:2,2", "linear:2,3,1", "hw:2,2,3,3", "hw:1,2,3,1,0"};
-    for (int i = 0; i < kInputs; ++i) {
-      const std::string seed = m.Pick(seeds);
-      switch (i % 4) {
-        case 0:
-        case 1: h.Feed(m.Text(seed, "linearhw:,0123-9 ", m.Int(1, 3)), Expect::kEither, ParseNominalSpec); break;
-        case 2: h.Feed(m.Random("linearhw:,0123-9x", m.Int(0, 20)), Expect::kEither, ParseNominalSpec); break;
-        default:  // a number that is not an integer, a missing count, an unknown kind
-          h.Feed(m.Pick<std::string>({seed + ".5", seed + ",", "arx" + seed.substr(seed.find(':')), "hw:2,2",
-                                      seed + ",x", "linear:", "linear:2,2,0,0"}),
-                 Expect::kInvalid, ParseNominalSpec);
-      }
-    }
-  }
-  {
-    Harness h("diagnose --effects", kInputs);
-    const std::vector<std::string> seeds = {"backlash@input,deadzone@output", "coulomb_friction@state",
-                                            "saturation@input,quantization@output"};
-    for (int i = 0; i < kInputs; ++i) {
-      const std::string seed = m.Pick(seeds);
-      switch (i % 4) {
-        case 0:
-        case 1: h.Feed(m.Text(seed, "@,_ ", m.Int(1, 2)), Expect::kEither, ParseCandidateList); break;
-        case 2: h.Feed(m.Random("backlash@input,", m.Int(0, 30)), Expect::kEither, ParseCandidateList); break;
-        default:  // an empty item, an unknown effect or location, a block that is not defined
-          h.Feed(m.Pick<std::string>({seed + ",", "," + seed, seed + ",backlash", seed + ",friction@input",
-                                      seed + ",backlash@output", seed + ",deadzone@nowhere", ""}),
-                 Expect::kInvalid, ParseCandidateList);
-      }
-    }
-  }
-  {
-    Harness h("diagnose recording", kInputs);
-    const std::vector<std::string> seeds = {"rec.csv", "rec.csv:u=vin,y=vout", "d/r.mat:u=vir,y=qm,t=time",
-                                            "C:/data/r.csv:t=time"};
-    for (int i = 0; i < kInputs; ++i) {
-      const std::string seed = m.Pick(seeds);
-      switch (i % 4) {
-        case 0:
-        case 1: h.Feed(m.Text(seed, "uyt=,:rec.sv/ ", m.Int(1, 4)), Expect::kEither, ParseDiagnoseRecordingSpec); break;
-        case 2: h.Feed(m.Random("uyt=,:rec.sv/", m.Int(0, 30)), Expect::kEither, ParseDiagnoseRecordingSpec); break;
-        default:  // an unknown key, an empty name, a column mapped twice, no file name
-          h.Feed(m.Pick<std::string>({"rec.csv:z=a", "rec.csv:u=", "rec.csv:u=a,,y=b", "rec.csv:u=a,u=b",
-                                      ":u=a", "rec.csv:u=a,y"}),
-                 Expect::kInvalid, ParseDiagnoseRecordingSpec);
-      }
-    }
-  }
+  // --fit: a number that is not an integer, a missing count, an unknown kind.
+  FuzzText(m,
+           {"diagnose --fit", {"linear:2,2", "linear:2,3,1", "hw:2,2,3,3", "hw:1,2,3,1,0"}, "linearhw:,0123-9 ",
+            [](const std::string& seed) {
+              return std::vector<std::string>{seed + ".5", seed + ",", "arx" + seed.substr(seed.find(':')), "hw:2,2",
+                                              seed + ",x", "linear:", "linear:2,2,0,0"};
+            },
+            ParseNominalSpec},
+           kInputs);
+  // --effects: an empty item, an unknown effect or location, a block that is not defined.
+  FuzzText(m,
+           {"diagnose --effects",
+            {"backlash@input,deadzone@output", "coulomb_friction@state", "saturation@input,quantization@output"},
+            "@,_ ",
+            [](const std::string& seed) {
+              return std::vector<std::string>{seed + ",", "," + seed, seed + ",backlash", seed + ",friction@input",
+                                              seed + ",backlash@output", seed + ",deadzone@nowhere", ""};
+            },
+            ParseCandidateList},
+           kInputs);
+  // --data, --validate: an unknown key, an empty name, a column mapped twice, no file name.
+  FuzzText(m,
+           {"diagnose recording",
+            {"rec.csv", "rec.csv:u=vin,y=vout", "d/r.mat:u=vir,y=qm,t=time", "C:/data/r.csv:t=time"},
+            "uyt=,:rec.sv/ ",
+            [](const std::string&) {
+              return std::vector<std::string>{"rec.csv:z=a", "rec.csv:u=",      "rec.csv:u=a,,y=b",
+                                              "rec.csv:u=a,u=b", ":u=a", "rec.csv:u=a,y"};
+            },
+            ParseDiagnoseRecordingSpec},
+           kInputs);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -483,19 +484,17 @@ TEST(ParserFuzz, RecordingSpecs) {
   auto read = [](const std::string& text) { CheckRecordingTable(read_recording(text, {"u", "y"}, {"t"})); };
   Mutator m(5);
   const std::vector<std::string> maps = {"u=u,y=y", "u=y,y=u,t=t", "y=u", "t=t", "u=u, y=y"};
-  {
-    Harness h("recording spec", kInputs);
-    for (int i = 0; i < kInputs; ++i) {
-      switch (i % 3) {
-        case 0: h.Feed(m.Text("r.mat:" + m.Pick(maps), "uyt=,:.matcsv ", m.Int(1, 4)), Expect::kEither, ParseRecordingSpec); break;
-        case 1: h.Feed(m.Random("uyt=,:.matcsv", m.Int(0, 30)), Expect::kEither, ParseRecordingSpec); break;
-        default:  // nothing after ':', an item without '=' or a name, a column mapped twice
-          h.Feed(m.Pick<std::string>({"r.mat:", "r.mat: ", "r.mat:u", "r.mat:=a", "r.mat:u=", "r.mat:u=a,,y=b",
-                                      "r.mat:u=a,u=b", "r.csv:u=a,", "r.CSV:,u=a"}),
-                 Expect::kInvalid, ParseRecordingSpec);
-      }
-    }
-  }
+  std::vector<std::string> specs;
+  for (const auto& map : maps) specs.push_back("r.mat:" + map);
+  // Nothing after ':', an item without '=' or a name, a column mapped twice.
+  FuzzText(m,
+           {"recording spec", specs, "uyt=,:.matcsv ",
+            [](const std::string&) {
+              return std::vector<std::string>{"r.mat:",   "r.mat: ",         "r.mat:u",       "r.mat:=a",   "r.mat:u=",
+                                              "r.mat:u=a,,y=b", "r.mat:u=a,u=b", "r.csv:u=a,", "r.CSV:,u=a"};
+            },
+            ParseRecordingSpec},
+           kInputs);
   Harness h("recording spec, read", kInputs);
   for (int i = 0; i < kInputs; ++i) {
     const std::string map = m.Pick(maps);
