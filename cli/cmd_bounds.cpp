@@ -18,7 +18,8 @@
 namespace hw::cli {
 namespace {
 
-// "--box -10,10" (all parameters) or "--box a1=0,3 --box b1=-5,5" (named); later entries win.
+// "--box -10,10" (all parameters) or "--box a1=0,3 --box b1=-5,5" (named); later entries win. The text's syntax
+// is checked here, the values by the library's ValidBoxEntry (the Python module's box gets the same message).
 std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>& specs,
                                                  const std::vector<std::string>& names) {
   std::vector<std::pair<double, double>> box(names.size(), {-10.0, 10.0});
@@ -31,19 +32,12 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
     double lo = 0, hi = 0;
     char comma = 0;
     std::istringstream in(range);
-    if (!(in >> lo >> comma >> hi) || comma != ',' || !(lo < hi))
-      throw InputError(fmt::format("--box '{}': expected LO,HI with LO < HI, or NAME=LO,HI", spec));
-    bool found = target.empty();
+    if (!(in >> lo >> comma >> hi) || comma != ',' || !(in >> std::ws).eof())
+      throw InputError(fmt::format("--box '{}': expected LO,HI (every parameter) or NAME=LO,HI", spec));
+    RequireOption(fmt::format("--box '{}'", spec),
+                  [&](std::string* e) { return relax::ValidBoxEntry(target, lo, hi, names, e); });
     for (std::size_t i = 0; i < names.size(); ++i)
-      if (target.empty() || names[i] == target) {
-        box[i] = {lo, hi};
-        found = true;
-      }
-    if (!found) {
-      std::string all;
-      for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
-      throw InputError(fmt::format("--box '{}': no parameter '{}'; the parameters are: {}", spec, target, all));
-    }
+      if (target.empty() || names[i] == target) box[i] = {lo, hi};
   }
   return box;
 }
@@ -64,11 +58,6 @@ std::vector<double> parse_list(const std::string& text, const std::string& what)
 
 // Exit status of a run whose data prove that no parameter in the prior box fits (README, `bounds --help`).
 constexpr int kExitInvalidated = 3;
-
-// True when every sign orthant is proven empty by a certificate: D^ss(n) within the prior box is empty, so
-// no parameter in the box explains the data within the noise bound.
-// (To be replaced by BoundsSummary::invalidated() when the engine provides it.)
-bool ModelInvalidated(const relax::BoundsSummary& s) { return s.orthants_total > 0 && s.orthants_empty == s.orthants_total; }
 
 struct BoundsCliOptions {
   std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
@@ -178,6 +167,15 @@ bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::
   return covered;
 }
 
+// How one orthant was proven empty, for a person: "LP screen, verified in interval arithmetic".
+std::string CertificateText(const relax::EmptinessCertificate& c) {
+  const std::string how = c.kind == "lp"               ? "LP screen infeasible"
+                          : c.kind == "relaxation"     ? fmt::format("order {} relaxation infeasible", c.order)
+                                                       : fmt::format("order {} bounds cross", c.order);
+  return fmt::format("{}{}, {}", how, c.contracted_box ? " in the contracted box" : "",
+                     c.verified ? "verified in interval arithmetic" : "the solver's floating-point certificate (unverified)");
+}
+
 // The verdict of an empty feasible set: what it means, which certificates prove it, where to look next.
 void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptions& o) {
   fmt::print("\nVERDICT: model invalidated. No parameter in the prior box explains the data within the noise bound: "
@@ -185,16 +183,17 @@ void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptio
              "wrong.\n",
              o.na, o.nb, o.input_basis, o.output_basis, o.horizon);
   std::map<std::string, int> by_certificate;
-  for (const auto& r : summary.orthants) ++by_certificate[r.status];
-  fmt::print("certificates: all {} sign orthants are proven empty ({}), each {}:\n", summary.orthants_total,
-             [&] {
-               std::string c;
-               for (const auto& [kind, n] : by_certificate) c += fmt::format("{}{} {}", c.empty() ? "" : ", ", n, kind);
-               return c;
-             }(),
-             o.no_verify ? "by the solver's floating-point certificate (--no-verify)"
-                         : "by a certificate verified in interval arithmetic");
-  for (const auto& r : summary.orthants) fmt::print("  orthant {:>3} ({}): {}\n", r.index, r.signs, r.status);
+  int verified = 0;
+  for (const auto& r : summary.orthants) {
+    ++by_certificate[r.status];
+    verified += r.certificate && r.certificate->verified ? 1 : 0;
+  }
+  std::string counts;
+  for (const auto& [kind, n] : by_certificate) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, kind);
+  fmt::print("certificates: all {} sign orthants are proven empty ({}); {} of them verified in interval arithmetic{}:\n",
+             summary.orthants_total, counts, verified, o.no_verify ? " (--no-verify)" : "");
+  for (const auto& r : summary.orthants)
+    fmt::print("  orthant {:>3} ({}): {}\n", r.index, r.signs, r.certificate ? CertificateText(*r.certificate) : r.status);
   fmt::print("next: `hwbounds diagnose --data REC --validate REC2 --fit hw:NA,NB,PIN,POUT` looks for what the model "
              "leaves out (docs/diagnose.md); a larger noise bound, other bases or orders, or a wider --box change the "
              "question.\n");
@@ -258,22 +257,12 @@ void PrintWarnings(const relax::BoundsSummary& summary, bool verify) {
 // The result JSON; an invalidated model has "invalidated": true and null interval values.
 nlohmann::json ResultJson(const relax::BoundsSummary& summary, const BoundsCliOptions& o, const relax::HwOuterSet& set,
                           const std::vector<double>& truth, bool covered) {
-  auto j = summary.to_json();
-  const bool invalidated = ModelInvalidated(summary);
-  j["invalidated"] = invalidated;
-  if (invalidated) {
-    j["verdict"] = "no parameter in the prior box explains the data within the noise bound: the model class or the "
-                   "noise bound is wrong";
-    for (auto& iv : j["intervals"]) {
-      iv["half_width"] = nullptr;
-      for (const char* side : {"lower", "upper"}) iv[side]["value"] = nullptr;
-    }
-  }
+  auto j = summary.to_json();  // "invalidated", the verdict, null intervals and each orthant's certificate
   j["data"] = o.data;
   j["data_warnings"] = set.warnings();
   j["structure"] = {{"na", o.na}, {"nb", o.nb}, {"proper", o.proper}, {"input_basis", o.input_basis},
                     {"output_basis", o.output_basis}};
-  if (!truth.empty() && !invalidated) {
+  if (!truth.empty() && !summary.invalidated()) {
     j["truth"] = truth;
     j["truth_covered"] = covered;
   }
@@ -374,7 +363,7 @@ void AddBoundsCommand(CLI::App& app) {
                  p.elapsed_seconds, p.eta_seconds);
     };
     const auto summary = relax::ComputeBounds(options, set, progress);
-    const bool invalidated = ModelInvalidated(summary);
+    const bool invalidated = summary.invalidated();
     bool covered = true;
     if (invalidated) PrintInvalidation(summary, *o);
     else covered = PrintIntervals(summary, names, truth);

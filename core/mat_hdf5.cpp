@@ -49,6 +49,10 @@ class Id {
   herr_t (*close_)(hid_t);
 };
 
+// Longest attribute string or link name read: far beyond MATLAB's (63-character names, class names); a longer
+// one comes from a damaged size field, whose claim is not allocated.
+constexpr std::size_t kMaxNameBytes = 4096;
+
 bool IsMatlabNumericClass(const std::string& c) {
   static const char* const kNames[] = {"double", "single", "int8",  "uint8",  "int16", "uint16",
                                        "int32",  "uint32", "int64", "uint64"};
@@ -74,7 +78,9 @@ std::optional<std::string> StringAttribute(hid_t object, const char* name) {
     if (text) value = text;
     H5Dvlen_reclaim(memory.get(), space.get(), H5P_DEFAULT, &text);
   } else {
-    std::string buffer(H5Tget_size(type.get()), '\0');
+    const std::size_t size = H5Tget_size(type.get());
+    if (size == 0 || size > kMaxNameBytes) return std::nullopt;
+    std::string buffer(size, '\0');
     if (H5Aread(attr.get(), type.get(), buffer.data()) < 0) return std::nullopt;
     value = buffer.substr(0, buffer.find('\0'));
     value.erase(value.find_last_not_of(' ') + 1);
@@ -215,9 +221,10 @@ class Hdf5Source : public MatSource {
 
   std::vector<double> ReadDoubles(const MatVariable& v) override {
     const Id dataset(H5Dopen2(file_.get(), v.name.c_str(), H5P_DEFAULT), H5Dclose);
+    if (!dataset.ok()) throw InputError(fmt::format("{}: variable '{}' could not be read{}", path_, v.name, Hdf5Detail()));
+    CheckStoredSize(dataset.get(), v);
     std::vector<double> values(v.elements());
-    if (!dataset.ok() ||
-        H5Dread(dataset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
+    if (H5Dread(dataset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
       throw InputError(fmt::format("{}: variable '{}' could not be read{}", path_, v.name, Hdf5Detail()));
     return values;
   }
@@ -231,13 +238,28 @@ class Hdf5Source : public MatSource {
     for (hsize_t i = 0; i < info.nlinks; ++i) {
       const ssize_t size =
           H5Lget_name_by_idx(file_.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
-      if (size < 0) continue;
+      if (size < 0 || static_cast<std::size_t>(size) > kMaxNameBytes) continue;
       std::string name(static_cast<std::size_t>(size) + 1, '\0');
       H5Lget_name_by_idx(file_.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, name.data(), name.size(), H5P_DEFAULT);
       name.resize(static_cast<std::size_t>(size));
       names.push_back(std::move(name));
     }
     return names;
+  }
+
+  // The samples a dataset's dimensions claim are stored in the file (a damaged dimension would make the reader
+  // allocate what it claims): without filters in at least that many bytes (chunks may hold more), deflated in at
+  // most 1032 times fewer (zlib's largest ratio).
+  void CheckStoredSize(hid_t dataset, const MatVariable& v) const {
+    const Id type(H5Dget_type(dataset), H5Tclose);
+    const Id plist(H5Dget_create_plist(dataset), H5Pclose);
+    const double needed = static_cast<double>(v.elements()) * static_cast<double>(H5Tget_size(type.get()));
+    const double stored = static_cast<double>(H5Dget_storage_size(dataset));
+    const bool filtered = plist.ok() && H5Pget_nfilters(plist.get()) > 0;
+    if (filtered ? needed > 1032.0 * stored : needed > stored)
+      throw InputError(fmt::format("{}: damaged variable '{}': it is {} {} ({} bytes) but the file stores {} bytes of "
+                                   "its data; save the file again",
+                                   path_, v.name, v.shape(), v.class_name, needed, stored));
   }
 
   std::string path_;

@@ -1,18 +1,27 @@
 #include "core/mat_recording.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <mutex>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 #include <matio.h>
+#include <nlohmann/json.hpp>
 
 #include "core/mat_hdf5.hpp"
+#include "core/mat_layout.hpp"
 #include "core/mat_source.hpp"
+#include "core/worker_process.hpp"
 
 namespace hw {
 namespace {
@@ -107,27 +116,32 @@ MatVariable Describe(const matvar_t& v) {
   return out;
 }
 
-// A v4, v5 or v7 file, read by libmatio; closed on scope exit.
+struct MatClose {
+  void operator()(mat_t* m) const { Mat_Close(m); }
+};
+
+// A v4, v5 or v7 file, read by libmatio once its layout is checked (core/mat_layout.hpp); closed on scope exit.
 class MatioSource : public MatSource {
  public:
   explicit MatioSource(const std::string& path) : path_(path) {
     InstallMatioLog();
     matio_last_message.clear();
-    mat_ = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
+    // Without a v5 or v7.3 header libmatio reads the file as v4, and allocates what a v4 header claims.
+    if (const int header = MatHeaderVersion(path); header != MAT_FT_MAT5 && header != MAT_FT_MAT73)
+      CheckMatV4Layout(path);
+    mat_.reset(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
     if (!mat_)
       throw InputError(
           fmt::format("{}: not a MATLAB .mat file that libmatio can read (v4, v5, v7 or v7.3){}; "
                       "save it with MATLAB's save(...) or scipy.io.savemat",
                       path, MatioDetail()));
+    if (Mat_GetVersion(mat_.get()) == MAT_FT_MAT5) CheckMatV5Layout(path);
   }
-  ~MatioSource() override { Mat_Close(mat_); }
-  MatioSource(const MatioSource&) = delete;
-  MatioSource& operator=(const MatioSource&) = delete;
 
   std::vector<MatVariable> Variables() override {
     std::vector<MatVariable> out;
-    Mat_Rewind(mat_);
-    while (matvar_t* v = Mat_VarReadNextInfo(mat_)) {
+    Mat_Rewind(mat_.get());
+    while (matvar_t* v = Mat_VarReadNextInfo(mat_.get())) {
       VarPtr info(v);
       out.push_back(Describe(*info));
     }
@@ -135,14 +149,14 @@ class MatioSource : public MatSource {
   }
 
   std::optional<MatVariable> Find(const std::string& name) override {
-    VarPtr info(Mat_VarReadInfo(mat_, name.c_str()));
+    VarPtr info(Mat_VarReadInfo(mat_.get(), name.c_str()));
     matio_last_message.clear();
     if (!info) return std::nullopt;
     return Describe(*info);
   }
 
   std::vector<double> ReadDoubles(const MatVariable& v) override {
-    VarPtr var(Mat_VarRead(mat_, v.name.c_str()));
+    VarPtr var(Mat_VarRead(mat_.get(), v.name.c_str()));
     if (!var || !var->data)
       throw InputError(fmt::format("{}: variable '{}' could not be read{}", path_, v.name, MatioDetail()));
     return AsDoubleSamples(*var);
@@ -150,7 +164,7 @@ class MatioSource : public MatSource {
 
  private:
   std::string path_;
-  mat_t* mat_ = nullptr;
+  std::unique_ptr<mat_t, MatClose> mat_;
 };
 
 // The reader of the file's kind: libhdf5 for v7.3 (HDF5) files, libmatio for the others.
@@ -159,6 +173,11 @@ std::unique_ptr<MatSource> OpenMat(const std::string& path) {
     throw InputError(fmt::format("{}: is a directory; expected a MATLAB .mat file", path));
   if (!std::ifstream(path)) throw InputError(fmt::format("{}: cannot open file", path));
   if (IsHdf5File(path)) return OpenHdf5Mat(path);
+  // libmatio would open it with libhdf5 itself, whose failures on such a file it does not report.
+  if (MatHeaderVersion(path) == MAT_FT_MAT73)
+    throw InputError(fmt::format("{}: a MATLAB v7.3 header without the HDF5 data that must follow it: the file is "
+                                 "damaged or cut short; save it again",
+                                 path));
   return std::make_unique<MatioSource>(path);
 }
 
@@ -200,21 +219,78 @@ std::vector<double> ReadVector(MatSource& file, const std::string& path, const s
   return values;
 }
 
-}  // namespace
-
-std::size_t MatVariable::elements() const {
-  std::size_t n = 1;
-  for (const auto d : dims) n *= d;
-  return dims.empty() ? 0 : n;
+void WriteAll(int fd, const std::string& text) {
+  for (std::size_t done = 0; done < text.size();) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n <= 0) return;  // the parent reports the short answer
+    done += static_cast<std::size_t>(n);
+  }
 }
 
-std::string MatVariable::shape() const {
-  std::string s;
-  for (std::size_t k = 0; k < dims.size(); ++k) s += (k ? "x" : "") + std::to_string(dims[k]);
-  return s.empty() ? "0x0" : s;
+std::string ReadAll(int fd) {
+  std::string text;
+  char buffer[65536];
+  for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  return text;
 }
 
-CsvTable read_mat_columns(const std::string& path, const std::vector<MatColumn>& columns) {
+// The text a reading child sends back: {"value": ...}, {"input_error": message} or {"error": message}. Never
+// throws (the child must not return into the caller's code); bytes of the file in a message that are not UTF-8
+// are replaced.
+std::string ChildAnswer(const std::function<nlohmann::json()>& work) {
+  try {
+    nlohmann::json answer;
+    try {
+      answer = {{"value", work()}};
+    } catch (const InputError& e) {
+      answer = {{"input_error", e.what()}};
+    } catch (const std::exception& e) {
+      answer = {{"error", e.what()}};
+    }
+    return answer.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  } catch (...) {
+    return R"({"error": "the reading process failed"})";
+  }
+}
+
+// Runs `work` on the file in a forked child and returns its answer. libhdf5 and libmatio can crash on a damaged
+// file (libhdf5 1.10 segfaults in H5Gget_info on some: tests/parser_fuzz_test.cpp); in a child, a crash is
+// reported as a damaged file instead of ending the process. An InputError of `work` is rethrown as it was.
+nlohmann::json InChildProcess(const std::string& path, const std::function<nlohmann::json()>& work) {
+  int fds[2];
+  if (::pipe(fds) != 0) throw std::runtime_error(fmt::format("{}: pipe: {}", path, std::strerror(errno)));
+  const pid_t parent = ::getpid();
+  const pid_t child = ::fork();
+  if (child < 0) throw std::runtime_error(fmt::format("{}: fork: {}", path, std::strerror(errno)));
+  if (child == 0) {
+    ::close(fds[0]);
+    EndWithParent(parent);
+    WriteAll(fds[1], ChildAnswer(work));
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  const std::string text = ReadAll(fds[0]);
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    throw InputError(fmt::format("{}: the MATLAB file reader crashed on this file (signal {}): the file is damaged; "
+                                 "save it again (MATLAB's save, scipy.io.savemat)",
+                                 path, WTERMSIG(status)));
+  const auto answer = nlohmann::json::parse(text, nullptr, false);
+  if (answer.is_discarded() || !answer.is_object())
+    throw std::runtime_error(fmt::format("{}: the reading process ended without an answer", path));
+  if (answer.contains("input_error")) throw InputError(answer.at("input_error").get<std::string>());
+  if (answer.contains("error")) throw std::runtime_error(answer.at("error").get<std::string>());
+  return answer.at("value");
+}
+
+CsvTable ReadColumns(const std::string& path, const std::vector<MatColumn>& columns) {
   const auto file = OpenMat(path);
   CsvTable table;
   table.source = path;
@@ -232,11 +308,41 @@ CsvTable read_mat_columns(const std::string& path, const std::vector<MatColumn>&
   return table;
 }
 
+}  // namespace
+
+std::size_t MatVariable::elements() const {
+  std::size_t n = 1;
+  for (const auto d : dims) n *= d;
+  return dims.empty() ? 0 : n;
+}
+
+std::string MatVariable::shape() const {
+  std::string s;
+  for (std::size_t k = 0; k < dims.size(); ++k) s += (k ? "x" : "") + std::to_string(dims[k]);
+  return s.empty() ? "0x0" : s;
+}
+
+CsvTable read_mat_columns(const std::string& path, const std::vector<MatColumn>& columns) {
+  // The samples come back as JSON numbers, which keep every bit of a finite double.
+  const auto j = InChildProcess(path, [&] {
+    const CsvTable t = ReadColumns(path, columns);
+    return nlohmann::json{{"names", t.names}, {"columns", t.columns}};
+  });
+  CsvTable table;
+  table.source = path;
+  const auto names = j.at("names").get<std::vector<std::string>>();
+  auto values = j.at("columns").get<std::vector<std::vector<double>>>();
+  for (std::size_t k = 0; k < names.size(); ++k) table.add_column(names[k], std::move(values[k]));
+  return table;
+}
+
 std::vector<std::string> mat_variable_names(const std::string& path) {
-  const auto file = OpenMat(path);
-  std::vector<std::string> names;
-  for (const auto& v : file->Variables()) names.push_back(v.name);
-  return names;
+  return InChildProcess(path, [&] {
+           std::vector<std::string> names;
+           for (const auto& v : OpenMat(path)->Variables()) names.push_back(v.name);
+           return nlohmann::json(names);
+         })
+      .get<std::vector<std::string>>();
 }
 
 }  // namespace hw

@@ -487,10 +487,11 @@ AugmentedModel AugmentedModel::from_json(const nlohmann::json& j) {
   if (j.contains("linear")) RequireKnownKeys(j.at("linear"), {"a", "b", "delay"}, "model JSON, linear");
   for (const char* k : {"input_nonlinearity", "output_nonlinearity"})
     if (j.contains(k)) CheckStaticMapKeys(j.at(k), fmt::format("model JSON, {}", k));
-  const std::string type = j.value("type", "hammerstein_wiener");
+  // Any JSON value may stand there: compared as JSON, not read as a string first.
+  const nlohmann::json type = j.value("type", nlohmann::json("hammerstein_wiener"));
   if (type != "hammerstein_wiener" && type != "augmented_hammerstein_wiener")
-    throw InputError(fmt::format("model JSON: type '{}' unknown; expected hammerstein_wiener or "
-                                 "augmented_hammerstein_wiener", type));
+    throw InputError(fmt::format("model JSON: type {} unknown; expected \"hammerstein_wiener\" or "
+                                 "\"augmented_hammerstein_wiener\"", type.dump()));
   AugmentedModel m;
   nlohmann::json base = j;  // the plain part goes to the project's reader
   for (const char* k : {"effect_blocks", "effect_block", "output_offset", "initial_state"}) base.erase(k);

@@ -55,11 +55,12 @@ RecordingSpec RecordingSpec::Parse(const std::string& text, const ColumnNames& d
   RecordingSpec s;
   s.columns = defaults;
   s.path = text;
+  if (text.empty()) throw InputError("recording '': no file name; expected FILE or FILE:u=NAME,y=NAME[,t=NAME]");
   const auto colon = text.rfind(':');
   if (colon == std::string::npos || text.find('=', colon) == std::string::npos) return s;
   s.path = text.substr(0, colon);
   std::istringstream in(text.substr(colon + 1));
-  std::string item;
+  std::string item, keys;  // keys: those given so far (a column named twice would silently take the last)
   while (std::getline(in, item, ',')) {
     const auto eq = item.find('=');
     const std::string key = eq == std::string::npos ? item : item.substr(0, eq);
@@ -67,6 +68,9 @@ RecordingSpec RecordingSpec::Parse(const std::string& text, const ColumnNames& d
     if (value.empty() || (key != "u" && key != "y" && key != "t"))
       throw InputError(fmt::format("recording '{}': '{}' not understood; expected FILE or FILE:u=NAME,y=NAME[,t=NAME]",
                                    text, item));
+    if (keys.find(key) != std::string::npos)
+      throw InputError(fmt::format("recording '{}': column '{}' is named twice; give each of u, y, t once", text, key));
+    keys += key;
     if (key == "u") s.columns.u = value;
     if (key == "y") s.columns.y = value;
     if (key == "t") s.columns.t = value, s.columns.t_required = true;

@@ -19,20 +19,21 @@ namespace {
 // {name: (lo, hi)} over that default, or one (lo, hi) per parameter.
 std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::vector<std::string>& names) {
   std::vector<std::pair<double, double>> box(names.size(), {-10.0, 10.0});
-  auto pair = [](py::handle p, const std::string& what) {
+  // The interval of `name` ("" = every parameter): a pair here, its values checked by the library (the CLI's
+  // --box gets the same message).
+  auto pair = [&names](py::handle p, const std::string& name) {
+    const std::string what = name.empty() ? "box" : "box['" + name + "']";
     const auto v = ToVector(p, what);
-    if (v.size() != 2 || !(v[0] < v[1])) throw py::value_error(fmt::format("{}: expected (LO, HI) with LO < HI", what));
+    if (v.size() != 2) throw py::value_error(fmt::format("{}: expected (LO, HI), got {} values", what, v.size()));
+    Require([&](std::string* e) { return relax::ValidBoxEntry(name, v[0], v[1], names, e); });
     return std::pair<double, double>{v[0], v[1]};
   };
   if (h.is_none()) return box;
   if (py::isinstance<py::dict>(h)) {
     for (const auto& [k, v] : h.cast<py::dict>()) {
       const std::string name = py::str(k);
-      const auto at = std::find(names.begin(), names.end(), name);
-      if (at == names.end())
-        throw py::value_error(
-            fmt::format("box: no parameter '{}'; the parameters are: {}", name, fmt::join(names, ", ")));
-      box[at - names.begin()] = pair(v, "box['" + name + "']");
+      const auto interval = pair(v, name);  // checks the name too
+      box[std::find(names.begin(), names.end(), name) - names.begin()] = interval;
     }
     return box;
   }
@@ -40,13 +41,13 @@ std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::ve
     throw py::type_error("box: expected None, (lo, hi), {name: (lo, hi)} or one (lo, hi) per parameter");
   const auto seq = h.cast<py::sequence>();
   if (seq.size() == 2 && !py::isinstance<py::sequence>(seq[0])) {
-    box.assign(names.size(), pair(h, "box"));
+    box.assign(names.size(), pair(h, ""));
     return box;
   }
   if (seq.size() != names.size())
     throw py::value_error(
         fmt::format("box: {} pairs for {} parameters ({})", seq.size(), names.size(), fmt::join(names, ", ")));
-  for (std::size_t i = 0; i < names.size(); ++i) box[i] = pair(seq[i], "box['" + names[i] + "']");
+  for (std::size_t i = 0; i < names.size(); ++i) box[i] = pair(seq[i], names[i]);
   return box;
 }
 

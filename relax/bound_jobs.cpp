@@ -31,6 +31,22 @@ double now_seconds() {
 
 std::string other_solver(const std::string& s) { return s == "csdp" ? "sdpa" : "csdp"; }
 
+// The run directory's record of the jobs dispatched so far (RunCache::plan).
+constexpr const char* kPlanFile = "planned.json";
+
+// The job keys in a plan file, or nothing when it is missing or damaged (then its count is not trusted).
+std::optional<std::set<std::string>> ReadPlannedJobs(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return std::nullopt;
+  try {
+    nlohmann::json j;
+    in >> j;
+    return j.at("planned_jobs").get<std::set<std::string>>();
+  } catch (...) {
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 nlohmann::json JobOutcome::to_json() const {
@@ -72,6 +88,11 @@ RunCache::RunCache(const std::string& root, const std::string& key, const nlohma
   fs::create_directories(dir / "jobs");
   if (!fs::exists(dir / "problem.json")) write_text_atomic((dir / "problem.json").string(), meta.dump(2));
   dir_ = dir.string();
+  if (auto keys = ReadPlannedJobs(dir / kPlanFile)) {
+    planned_ = std::move(*keys);
+    planned_by_earlier_runs_ = planned_.size();
+    earlier_plan_known_ = true;
+  }
 }
 
 std::optional<nlohmann::json> RunCache::load(const std::string& name) const {
@@ -97,6 +118,27 @@ int RunCache::stored_jobs() const {
   for (const auto& e : fs::directory_iterator(fs::path(dir_) / "jobs"))
     if (e.path().extension() == ".json") ++n;
   return n;
+}
+
+void RunCache::plan(const std::vector<std::string>& names) const {
+  if (!enabled()) return;
+  const std::size_t before = planned_.size();
+  planned_.insert(names.begin(), names.end());
+  if (planned_.size() != before || !fs::exists(fs::path(dir_) / kPlanFile))
+    write_text_atomic((fs::path(dir_) / kPlanFile).string(), nlohmann::json{{"planned_jobs", planned_}}.dump());
+}
+
+std::optional<std::string> RunCache::resume_line() const {
+  const int stored = stored_jobs();
+  if (stored == 0) return std::nullopt;
+  constexpr const char* kRest = "each phase counts only the jobs still to run";
+  if (!earlier_plan_known_)  // a directory written before planned.json existed, or a damaged plan
+    return fmt::format("resuming: {} finished jobs from {} (the earlier run's plan is not recorded); {}", stored,
+                       dir_, kRest);
+  std::size_t finished = 0;
+  for (const auto& name : planned_) finished += load(name).has_value() ? 1 : 0;
+  return fmt::format("resuming: {} of {} jobs planned so far are finished, from {}; later phases may plan more, and {}",
+                     finished, planned_by_earlier_runs_, dir_, kRest);
 }
 
 ProgressReporter::ProgressReporter(std::function<void(const BoundsProgress&)> sink) : sink_(std::move(sink)) {}
@@ -296,6 +338,9 @@ void DispatchJobs(EngineContext& ctx, const std::vector<std::pair<std::string, s
   std::vector<std::string> specs;
   std::vector<std::size_t> spec_job;
   std::vector<std::pair<std::size_t, nlohmann::json>> cached;
+  std::vector<std::string> keys;
+  for (const auto& job : jobs) keys.push_back(job.second);
+  ctx.cache.plan(keys);
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     if (auto j = ctx.cache.load(jobs[i].second)) {
       cached.push_back({i, std::move(*j)});
@@ -377,7 +422,8 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
     ctx.counters.largest_blocks = std::max(ctx.counters.largest_blocks, out.blocks);
     if (out.status == "infeasible") {
       OrthantWork& o = orthants.at(static_cast<std::size_t>(&*jobs[i].orthant - orthants.data()));
-      if (!o.empty()) o.status = fmt::format("empty (order {}{})", jobs[i].order, o.box != ctx.set.box() ? ", contracted box" : "");
+      if (!o.empty())
+        o.ProveEmpty({"relaxation", jobs[i].order, o.box != ctx.set.box(), out.verification == "verified"});
     }
     ctx.progress.Done();
   });

@@ -18,6 +18,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,9 @@ struct JobOutcome {
 };
 
 // Cache of finished jobs in run_dir/<problem hash>/jobs/; a damaged file is recomputed, never trusted.
+// Next to jobs/, planned.json lists the key of every job dispatched so far (by this run and the runs before it):
+// jobs are planned phase by phase, so the whole run's count is not known in advance, but the jobs the earlier
+// runs planned are, and a resumed run reports how many of those are finished.
 class RunCache {
  public:
   RunCache() = default;
@@ -69,10 +73,19 @@ class RunCache {
   std::string path() const { return dir_; }
   std::optional<nlohmann::json> load(const std::string& name) const;
   void store(const std::string& name, const nlohmann::json& j) const;
-  int stored_jobs() const;  // finished jobs on disk (for the "resuming" line)
+  int stored_jobs() const;  // finished jobs on disk
+  // Adds the keys of jobs about to be dispatched to planned.json (written atomically).
+  void plan(const std::vector<std::string>& names) const;
+  // The line a resumed run starts with ("resuming: K of M jobs planned so far are finished, in DIR; ..."), or
+  // nothing when the directory holds no finished job. Counts what the earlier runs left, before this run plans.
+  std::optional<std::string> resume_line() const;
 
  private:
   std::string dir_;
+  // Keys in planned.json: read when the cache opens (the earlier runs' plan), then grown by plan().
+  mutable std::set<std::string> planned_;
+  std::size_t planned_by_earlier_runs_ = 0;
+  bool earlier_plan_known_ = false;  // planned.json was there and readable
 };
 
 // Counters every stage adds to (they end up in BoundsSummary).
@@ -129,7 +142,12 @@ struct OrthantWork {
   std::vector<int> rows;
   std::vector<nlohmann::json> reduction;  // per step: {"step", "rows", "kept"} (JSON of RowGroupCount)
   std::string status = "undecided";       // or "empty (...)": the certificate that proved it empty
+  std::optional<EmptinessCertificate> certificate;  // set with the status by ProveEmpty
   bool empty() const { return status.rfind("empty", 0) == 0; }
+  void ProveEmpty(const EmptinessCertificate& c) {
+    certificate = c;
+    status = c.status();
+  }
 };
 
 // One relaxation job: objective over an orthant at an order, with blocks for `initial` (indices into rows).

@@ -91,7 +91,8 @@ double ContractBoxes(EngineContext& ctx, const std::vector<Objective>& objective
       shrink = std::max(shrink, 1.0 - (next[k].second - next[k].first) / width);
     }
     if (crossed) {
-      o.status = fmt::format("empty (order {}, contracted box)", order);
+      // Only verified bounds enter the contraction when verification is on (above).
+      o.ProveEmpty({"crossed bounds", order, true, verify_on});
       continue;
     }
     o.box = next;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
 
@@ -110,6 +111,19 @@ std::vector<Polynomial> Scaling::substitution() const {
   return v;
 }
 
+bool ValidBoxEntry(const std::string& name, double lo, double hi, const std::vector<std::string>& names,
+                   std::string* error) {
+  if (!name.empty() && std::find(names.begin(), names.end(), name) == names.end()) {
+    if (error) *error = fmt::format("box: no parameter '{}'; the parameters are: {}", name, fmt::join(names, ", "));
+    return false;
+  }
+  if (lo < hi && std::isfinite(lo) && std::isfinite(hi)) return true;
+  if (error)
+    *error = fmt::format("box{}: ({}, {}) is not an interval; expected (LO, HI) with LO < HI, both finite",
+                         name.empty() ? "" : " of " + name, lo, hi);
+  return false;
+}
+
 HwOuterSet::HwOuterSet(HwStructure structure, HwData data, int horizon, std::vector<std::pair<double, double>> box)
     : structure_(std::move(structure)), data_(std::move(data)), horizon_(horizon), box_(std::move(box)) {
   std::string error;
@@ -125,8 +139,8 @@ HwOuterSet::HwOuterSet(HwStructure structure, HwData data, int horizon, std::vec
                                  lag + horizon_ + 1));
   if (static_cast<int>(box_.size()) != n)
     throw InputError(fmt::format("the prior box has {} intervals; the model has {} parameters", box_.size(), n));
-  for (const auto& [lo, hi] : box_)
-    if (!(lo < hi)) throw InputError("every box interval needs lo < hi");
+  for (int k = 0; k < n; ++k)
+    if (!ValidBoxEntry(layout_.names[k], box_[k].first, box_[k].second, layout_.names, &error)) throw InputError(error);
   scaling_ = Scaling::FromBox(box_);
   scaled_vars_ = scaling_.substitution();
 

@@ -54,6 +54,12 @@ int MinimalOrder(int horizon);
 // --noise-bound and the Python module's noise_bound) in *error otherwise.
 bool ValidNoiseBound(double noise_bound, std::string* error);
 
+// One entry of the prior box: the interval (lo, hi) of the parameter `name`, or of every parameter when `name` is
+// empty. The name is one of `names`; lo < hi, both finite. False with the message (shared by HwOuterSet, the CLI's
+// --box and the Python module's box) in *error otherwise.
+bool ValidBoxEntry(const std::string& name, double lo, double hi, const std::vector<std::string>& names,
+                   std::string* error);
+
 // The model class of paper 001's example: psi = phi = (w, w^2, w^3), na = nb = 2, strictly proper.
 HwStructure CeroneExampleStructure();
 

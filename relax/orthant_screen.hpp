@@ -4,6 +4,7 @@
 // an infeasible LP, with its certificate verified, proves the orthant empty. One LP per orthant over all rows is
 // far cheaper than reducing the rows of orthants that are empty anyway, so the screen runs before the reduction;
 // the reduction would not change its verdict (a dropped row is implied in the LP too).
+#include <optional>
 #include <vector>
 
 #include "relax/bound_jobs.hpp"
@@ -17,6 +18,7 @@ struct ScreenOptions {
 struct ScreenResult {
   std::vector<int> alive;                 // orthants not proven empty, ascending
   std::vector<std::string> status;        // per orthant: "empty (LP)" or "undecided"
+  std::vector<std::optional<EmptinessCertificate>> certificates;  // per orthant: the LP certificate of an empty one
 };
 
 ScreenResult ScreenOrthants(const ScreenOptions& options, EngineContext& ctx);

@@ -147,6 +147,17 @@ bool BoundsOptions::IsValid(std::string* error) const {
   return generation.IsValid(error);
 }
 
+std::string EmptinessCertificate::status() const {
+  if (kind == "lp") return "empty (LP)";
+  return fmt::format("empty (order {}{}{})", order, contracted_box ? ", contracted box" : "",
+                     kind == "crossed bounds" ? ", bounds cross" : "");
+}
+
+nlohmann::json EmptinessCertificate::to_json() const {
+  return {{"kind", kind}, {"order", kind == "lp" ? nlohmann::json(nullptr) : nlohmann::json(order)},
+          {"contracted_box", contracted_box}, {"verified", verified}};
+}
+
 bool BoundsSummary::invalidated() const {
   if (orthants_total == 0 || orthants_empty != orthants_total) return false;
   for (const auto& o : orthants)
@@ -187,7 +198,9 @@ nlohmann::json BoundsSummary::to_json() const {
   for (const auto& iv : intervals)
     j["intervals"].push_back({{"parameter", iv.name}, {"lower", ep(iv.lower)}, {"upper", ep(iv.upper)},
                               {"half_width", none ? nlohmann::json(nullptr) : nlohmann::json(iv.half_width())}});
-  for (const auto& o : orthants) j["orthants"].push_back({{"index", o.index}, {"signs", o.signs}, {"status", o.status}});
+  for (const auto& o : orthants)
+    j["orthants"].push_back({{"index", o.index}, {"signs", o.signs}, {"status", o.status},
+                             {"certificate", o.certificate ? o.certificate->to_json() : nlohmann::json(nullptr)}});
   j["counts"] = {{"orthants_total", orthants_total}, {"orthants_proven_empty", orthants_empty},
                  {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
                  {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache},
@@ -255,9 +268,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   const RunCache cache(options.run_dir, ProblemKey(options, set, &meta), meta);
   EngineCounters counters;
   ProgressReporter reporter(progress);
-  if (const int stored = cache.stored_jobs(); stored > 0)
-    reporter.Message(fmt::format("resuming: {} finished jobs from {}; each phase counts only the jobs still to run",
-                                 stored, cache.path()));
+  if (const auto line = cache.resume_line()) reporter.Message(*line);
   EngineContext ctx{options, set, *executor, job, cache, counters, reporter};
 
   // 1. Screen orthants.
@@ -305,7 +316,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.parameter_names = set.layout().names;
   summary.orthants_total = set.num_orthants();
   std::vector<std::string> status = screen.status;
+  std::vector<std::optional<EmptinessCertificate>> certificate = screen.certificates;
   for (const auto& w : orthants) {
+    if (w.empty()) certificate[w.index] = w.certificate;
     bool failed = false;
     for (int o : wanted_objectives)
       if (full.count({w.index, o}) && full.at({w.index, o}).status == "failed") failed = true;
@@ -317,7 +330,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
     if (status[l].rfind("empty", 0) == 0) ++summary.orthants_empty;
     else if (status[l].rfind("failed", 0) == 0) ++summary.orthants_failed;
     else ++summary.orthants_solved;
-    summary.orthants.push_back({l, sign_text(set, l), status[l]});
+    summary.orthants.push_back({l, sign_text(set, l), status[l], certificate[l]});
   }
   summary.edge_witness_solves = edges.local_solves;
   summary.edge_witness_seconds = edges.seconds;

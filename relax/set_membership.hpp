@@ -17,6 +17,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -85,10 +86,23 @@ struct ParameterInterval {
   double half_width() const { return 0.5 * (upper.value - lower.value); }
 };
 
+// How a sign orthant was proven empty.
+struct EmptinessCertificate {
+  // "lp": the LP screen is infeasible; "relaxation": the relaxation of order `order` is infeasible;
+  // "crossed bounds": the rigorous lower and upper bounds of a parameter at order `order` cross.
+  std::string kind;
+  int order = 0;                // relaxation order (0 for the LP screen)
+  bool contracted_box = false;  // proven in the orthant's contracted box, which holds all its points of the prior box
+  bool verified = false;        // checked in interval arithmetic; false: the solver's floating-point certificate
+  std::string status() const;   // the orthant's status: "empty (LP)", "empty (order 2, contracted box)", ...
+  nlohmann::json to_json() const;
+};
+
 struct OrthantReport {
   int index = 0;
   std::string signs;    // e.g. "alpha2+ alpha3+ Q1_1+ ..."
   std::string status;   // "empty (LP)", "empty (order k)", "solved", "failed (conservative)"
+  std::optional<EmptinessCertificate> certificate;  // of an empty orthant
 };
 
 struct BoundsProgress {

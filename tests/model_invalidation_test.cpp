@@ -68,6 +68,8 @@ TEST(ModelInvalidation, DeadZoneRecordingInvalidatesTheCubicModelClass) {
       << out;
   EXPECT_TRUE(Has(out, "all 16 sign orthants are proven empty")) << out;
   EXPECT_TRUE(Has(out, "orthant  15")) << out;  // one certificate line per orthant
+  EXPECT_TRUE(Has(out, "16 of them verified in interval arithmetic")) << out;
+  EXPECT_TRUE(Has(out, "): LP screen infeasible, verified in interval arithmetic")) << out;
   EXPECT_TRUE(Has(out, "hwbounds diagnose")) << out;
   EXPECT_FALSE(Has(out, "conservative fallbacks")) << out;
   EXPECT_FALSE(Has(out, "0.000000     0.000000")) << "intervals printed as zeros: " << out;
@@ -78,6 +80,16 @@ TEST(ModelInvalidation, DeadZoneRecordingInvalidatesTheCubicModelClass) {
   for (const auto& iv : j.at("intervals")) {
     EXPECT_TRUE(iv.at("lower").at("value").is_null()) << iv.dump();
     EXPECT_TRUE(iv.at("upper").at("value").is_null()) << iv.dump();
+  }
+  // Each orthant says how its emptiness was certified.
+  ASSERT_EQ(j.at("orthants").size(), 16u);
+  for (const auto& o : j.at("orthants")) {
+    const auto& c = o.at("certificate");
+    ASSERT_TRUE(c.is_object()) << o.dump();
+    EXPECT_EQ(c.at("kind"), "lp") << o.dump();
+    EXPECT_TRUE(c.at("order").is_null()) << o.dump();
+    EXPECT_EQ(c.at("contracted_box"), false) << o.dump();
+    EXPECT_EQ(c.at("verified"), true) << o.dump();
   }
 }
 
@@ -98,6 +110,11 @@ TEST(ModelInvalidation, ARecordingInsideTheClassIsNotInvalidated) {
   nlohmann::json j;
   std::ifstream(d / "inside.json") >> j;
   EXPECT_FALSE(j.at("invalidated").get<bool>());
+  // An orthant has a certificate exactly when it is proven empty.
+  for (const auto& o : j.at("orthants")) {
+    const bool empty = o.at("status").get<std::string>().rfind("empty", 0) == 0;
+    EXPECT_EQ(o.at("certificate").is_object(), empty) << o.dump();
+  }
 }
 
 }  // namespace

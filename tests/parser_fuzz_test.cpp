@@ -1,14 +1,19 @@
 // Every parser of user input, fed random and grammar-aware mutated inputs in-process: CSV recordings,
-// polynomial expressions, and every JSON reader (pop problems, models, scenarios, constraints, Brouri plans,
-// estimates and systems). Each input must end in a result or a clear InputError (never another exception, a
-// crash or a hang), and inputs that are invalid by construction (an unknown key, a typo in a key, truncated
-// JSON, a fractional exponent, a missing operator, a duplicate column, a cell that is no number) must be
-// rejected. Accepted inputs must mean what they say (invariants checked below). Seeded: reproducible.
+// polynomial expressions, every JSON reader (pop problems, models, diagnose's augmented models, scenarios,
+// constraints, Brouri plans, estimates and systems), the recording specs (FILE:u=VAR,y=VAR,t=VAR, and
+// diagnose's), diagnose's --fit and --effects texts, and .mat files (v5 and v7.3 bytes, mutated, read from temp
+// files). Each input must end in a result or a clear InputError (never another exception, a crash or a hang),
+// and inputs that are invalid by construction (an unknown key, a typo in a key, truncated JSON or .mat bytes, a
+// fractional exponent, a missing operator, a duplicate column, a cell that is no number, a column mapped twice)
+// must be rejected. Accepted inputs must mean what they say (invariants checked below). Seeded: reproducible.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <set>
 #include <string>
@@ -18,6 +23,10 @@
 #include "core/hw_model.hpp"
 #include "core/json_input.hpp"
 #include "core/polynomial.hpp"
+#include "core/recording.hpp"
+#include "diagnose/effects.hpp"
+#include "diagnose/nominal_fit.hpp"
+#include "diagnose/recording.hpp"
 #include "estimators/brouri/experiment.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 #include "relax/pop_json.hpp"
@@ -34,10 +43,11 @@ enum class Expect { kEither, kInvalid };
 // Runs one parser over many inputs and keeps the first few failures for the report.
 class Harness {
  public:
-  explicit Harness(std::string name) : name_(std::move(name)) {}
+  // `minimum`: the inputs this parser must have been fed.
+  explicit Harness(std::string name, int minimum = kInputsPerParser) : name_(std::move(name)), minimum_(minimum) {}
   ~Harness() {
     EXPECT_TRUE(failures_.empty()) << name_ << ": " << failures_.size() << " failures, first:\n" << first_failures_;
-    EXPECT_GE(accepted_ + rejected_, kInputsPerParser) << name_;
+    EXPECT_GE(accepted_ + rejected_, minimum_) << name_;
     EXPECT_LT(slowest_, 2.0) << name_ << ": slowest input took " << slowest_ << " s: " << slowest_input_;
     std::printf("%-22s %6d inputs: %6d accepted, %6d rejected, slowest %.4f s\n", name_.c_str(), accepted_ + rejected_,
                 accepted_, rejected_, slowest_);
@@ -69,6 +79,7 @@ class Harness {
 
  private:
   std::string name_, first_failures_, slowest_input_;
+  int minimum_;
   std::vector<std::string> failures_;
   int accepted_ = 0, rejected_ = 0;
   double slowest_ = 0.0;
@@ -284,6 +295,17 @@ json CeroneModelJson() {
     "output_nonlinearity": {"kind": "piecewise_linear", "x": [-1, 0, 1], "y": [-2, 0, 1]}})");
 }
 
+// diagnose's model: a nominal model with two effect blocks, an output offset and an initial state.
+json DiagnoseModelJson() {
+  json j = CeroneModelJson();
+  j["type"] = "augmented_hammerstein_wiener";
+  j["effect_blocks"] = json::parse(R"([{"effect": "backlash", "location": "input", "parameters": {"half_width": 0.1}},
+    {"effect": "saturation", "location": "output", "parameters": {"lower": -1, "upper": 2}}])");
+  j["output_offset"] = 0.25;
+  j["initial_state"] = {0.1, -0.2};
+  return j;
+}
+
 std::vector<JsonReader> Readers() {
   const auto steps = brouri::MakeStepPlan({-0.6, 0, 0.6, 1.2}, {1.0, 0.2, -0.6, -1.4}, -0.9, 0.5, 10, 10);
   brouri::NonlinearEstimate est;
@@ -299,6 +321,7 @@ std::vector<JsonReader> Readers() {
                        "box": {"x1": [-2, 2], "x2": [-2, 2]}})"),
        [](const json& j) { relax::ParsePolyProblem(j, "fuzz.json"); }},
       {"model", CeroneModelJson(), [](const json& j) { HwModel::from_json(j); }},
+      {"diagnose model", DiagnoseModelJson(), [](const json& j) { diagnose::AugmentedModel::from_json(j); }},
       {"compare scenario",
        json{{"name", "s"}, {"plant", "hw"}, {"model", CeroneModelJson()}, {"output_inverse_polynomial", {1, 0.8}},
             {"input_range", {-2, 2}}, {"noise", {{"snr_db", 31}}},
@@ -342,6 +365,203 @@ TEST(ParserFuzz, JsonReaders) {
       }
     }
   }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// diagnose's texts: --fit (NominalSpec), --effects (candidate blocks), --data/--validate (its recording spec).
+
+void ParseNominalSpec(const std::string& text) {
+  const auto spec = diagnose::NominalSpec::Parse(text);
+  std::string error;
+  if (!spec.IsValid(&error)) throw std::logic_error("accepted an invalid structure: " + error);
+  const auto again = diagnose::NominalSpec::Parse(spec.Text());  // its printed form means the same
+  if (again.Text() != spec.Text()) throw std::logic_error("printed form reads back as " + again.Text());
+}
+
+void ParseCandidateList(const std::string& text) {
+  const auto blocks = diagnose::ParseCandidates(text);
+  if (blocks.empty()) throw std::logic_error("no block");
+  for (const auto& [e, l] : blocks)
+    if (!diagnose::IsDefined(e, l)) throw std::logic_error("an undefined block");
+}
+
+void ParseDiagnoseRecordingSpec(const std::string& text) {
+  const auto spec = diagnose::RecordingSpec::Parse(text, diagnose::ColumnNames{});
+  if (spec.path.empty()) throw std::logic_error("no path");
+  for (const auto* name : {&spec.columns.u, &spec.columns.y, &spec.columns.t})
+    if (name->empty() || name->find(',') != std::string::npos) throw std::logic_error("column name '" + *name + "'");
+}
+
+// One text parser: half its inputs are edits of a valid seed (over `alphabet`), a quarter random text over it (either
+// outcome), a quarter invalid by construction (`invalid(seed)` lists such texts; each must be rejected).
+struct TextTarget {
+  std::string name;
+  std::vector<std::string> seeds;
+  std::string alphabet;
+  std::function<std::vector<std::string>(const std::string& seed)> invalid;
+  std::function<void(const std::string&)> parse;
+};
+
+void FuzzText(Mutator& m, const TextTarget& target, int inputs) {
+  Harness h(target.name, inputs);
+  for (int i = 0; i < inputs; ++i) {
+    const std::string seed = m.Pick(target.seeds);
+    if (i % 4 < 2) h.Feed(m.Text(seed, target.alphabet, m.Int(1, 3)), Expect::kEither, target.parse);
+    else if (i % 4 == 2) h.Feed(m.Random(target.alphabet, m.Int(0, 30)), Expect::kEither, target.parse);
+    else h.Feed(m.Pick(target.invalid(seed)), Expect::kInvalid, target.parse);
+  }
+}
+
+TEST(ParserFuzz, DiagnoseTexts) {
+  constexpr int kInputs = 3000;
+  Mutator m(4);
+  // --fit: a number that is not an integer, a missing count, an unknown kind.
+  FuzzText(m,
+           {"diagnose --fit", {"linear:2,2", "linear:2,3,1", "hw:2,2,3,3", "hw:1,2,3,1,0"}, "linearhw:,0123-9 ",
+            [](const std::string& seed) {
+              return std::vector<std::string>{seed + ".5", seed + ",", "arx" + seed.substr(seed.find(':')), "hw:2,2",
+                                              seed + ",x", "linear:", "linear:2,2,0,0"};
+            },
+            ParseNominalSpec},
+           kInputs);
+  // --effects: an empty item, an unknown effect or location, a block that is not defined.
+  FuzzText(m,
+           {"diagnose --effects",
+            {"backlash@input,deadzone@output", "coulomb_friction@state", "saturation@input,quantization@output"},
+            "@,_ ",
+            [](const std::string& seed) {
+              return std::vector<std::string>{seed + ",", "," + seed, seed + ",backlash", seed + ",friction@input",
+                                              seed + ",backlash@output", seed + ",deadzone@nowhere", ""};
+            },
+            ParseCandidateList},
+           kInputs);
+  // --data, --validate: an unknown key, an empty name, a column mapped twice, no file name.
+  FuzzText(m,
+           {"diagnose recording",
+            {"rec.csv", "rec.csv:u=vin,y=vout", "d/r.mat:u=vir,y=qm,t=time", "C:/data/r.csv:t=time"},
+            "uyt=,:rec.sv/ ",
+            [](const std::string&) {
+              return std::vector<std::string>{"rec.csv:z=a", "rec.csv:u=",      "rec.csv:u=a,,y=b",
+                                              "rec.csv:u=a,u=b", ":u=a", "rec.csv:u=a,y"};
+            },
+            ParseDiagnoseRecordingSpec},
+           kInputs);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Recording specs FILE[:COLUMN=VARIABLE,...] (core/recording.hpp): parsed, and read from the CSV fixture.
+
+const std::string kData = std::string(HW_SOURCE_DIR) + "/tests/data";
+
+// An accepted recording has u and y (and t when given) of one length, every value finite, t increasing.
+void CheckRecordingTable(const CsvTable& t) {
+  if (!t.has("u") || !t.has("y")) throw std::logic_error("u or y missing");
+  const std::size_t n = t.column("u").size();
+  if (n == 0) throw std::logic_error("no samples");
+  for (const auto& c : t.columns) {
+    if (c.size() != n) throw std::logic_error("columns of different lengths");
+    for (double v : c)
+      if (!std::isfinite(v)) throw std::logic_error("non-finite sample");
+  }
+  if (!t.has("t")) return;
+  const auto& time = t.column("t");
+  for (std::size_t i = 1; i < time.size(); ++i)
+    if (!(time[i] > time[i - 1])) throw std::logic_error("t does not increase");
+}
+
+void ParseRecordingSpec(const std::string& text) {
+  const RecordingSpec spec = RecordingSpec::Parse(text);
+  std::set<std::string> columns;
+  for (const auto& c : spec.map) {
+    if (c.column.empty() || c.variable.empty()) throw std::logic_error("an empty name in the map");
+    if (!columns.insert(c.column).second) throw std::logic_error("column '" + c.column + "' mapped twice");
+  }
+}
+
+TEST(ParserFuzz, RecordingSpecs) {
+  constexpr int kInputs = 3000;
+  const std::string csv = kData + "/recording.csv";  // columns t, u, y
+  auto read = [](const std::string& text) { CheckRecordingTable(read_recording(text, {"u", "y"}, {"t"})); };
+  Mutator m(5);
+  const std::vector<std::string> maps = {"u=u,y=y", "u=y,y=u,t=t", "y=u", "t=t", "u=u, y=y"};
+  std::vector<std::string> specs;
+  for (const auto& map : maps) specs.push_back("r.mat:" + map);
+  // Nothing after ':', an item without '=' or a name, a column mapped twice.
+  FuzzText(m,
+           {"recording spec", specs, "uyt=,:.matcsv ",
+            [](const std::string&) {
+              return std::vector<std::string>{"r.mat:",   "r.mat: ",         "r.mat:u",       "r.mat:=a",   "r.mat:u=",
+                                              "r.mat:u=a,,y=b", "r.mat:u=a,u=b", "r.csv:u=a,", "r.CSV:,u=a"};
+            },
+            ParseRecordingSpec},
+           kInputs);
+  Harness h("recording spec, read", kInputs);
+  for (int i = 0; i < kInputs; ++i) {
+    const std::string map = m.Pick(maps);
+    if (i % 3 == 2)  // a column the command does not read, or one mapped twice, or a source column not in the file
+      h.Feed(csv + ":" + map + m.Pick<std::string>({",z=u", ",q=y", ",t=time,t=u", ",u=time"}), Expect::kInvalid, read);
+    else
+      h.Feed(csv + ":" + m.Text(map, "uyt=, ", m.Int(1, 3)), Expect::kEither, read);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// .mat files: the bytes of the v5 and v7.3 fixtures, mutated, written to a temp file and read as a recording.
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Format-aware byte mutations: the tags, sizes and dimensions of both formats are aligned 4- and 8-byte words,
+// so besides random bytes and slices, aligned words are set to values that stress a reader (0, 1, -1, huge).
+std::string MutateBytes(Mutator& m, std::string b) {
+  const int edits = m.Int(1, 4);
+  for (int k = 0; k < edits && !b.empty(); ++k) {
+    const std::size_t at = static_cast<std::size_t>(m.Int(0, static_cast<int>(b.size()) - 1));
+    switch (m.Int(0, 5)) {
+      case 0: b[at] = static_cast<char>(m.Int(0, 255)); break;
+      case 1: b[at] = static_cast<char>(b[at] ^ (1 << m.Int(0, 7))); break;
+      case 2: b.erase(at, m.Int(1, 16)); break;
+      case 3: b.insert(at, b.substr(m.Int(0, static_cast<int>(b.size()) - 1), m.Int(1, 16))); break;
+      default: {
+        const std::size_t word = at / 4 * 4;
+        const std::uint32_t values[] = {0u, 1u, 2u, 8u, 0x7fffffffu, 0xffffffffu, 0x80000000u, 40u, 41u, 0xffffu};
+        const std::uint32_t v = values[m.Int(0, 9)];
+        for (int byte = 0; byte < 4 && word + byte < b.size(); ++byte) b[word + byte] = static_cast<char>(v >> (8 * byte));
+      }
+    }
+  }
+  return b;
+}
+
+TEST(ParserFuzz, MatFiles) {
+  constexpr int kInputsPerFile = 800;  // each read forks a reader (core/mat_recording.cpp)
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "parser_fuzz_mat";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "fuzz.mat").string();
+  auto read = [&path](const std::string& bytes) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    CheckRecordingTable(read_recording(path + ":u=vir,y=qm,t=time", {"u", "y"}, {"t"}));
+  };
+  Mutator m(6);
+  for (const char* fixture : {"recording_v5.mat", "recording_v73.mat", "recording_v73_nullpad.mat"}) {
+    const std::string bytes = FileBytes(kData + "/" + fixture);
+    ASSERT_FALSE(bytes.empty()) << fixture;
+    Harness h(std::string(".mat ") + fixture, kInputsPerFile);
+    h.Feed(bytes, Expect::kEither, read);
+    for (int i = 0; i < kInputsPerFile; ++i) {
+      switch (i % 7) {
+        case 0: {  // cut short: the last variable's data is incomplete
+          h.Feed(bytes.substr(0, m.Int(0, static_cast<int>(bytes.size()) - 1)), Expect::kInvalid, read);
+          break;
+        }
+        case 1: h.Feed(m.Random(bytes.substr(0, 200), m.Int(0, 600)), Expect::kEither, read); break;
+        default: h.Feed(MutateBytes(m, bytes), Expect::kEither, read);
+      }
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
-// A run resumed from its run directory says so, reads every finished job back, gives the same intervals, and
-// its progress counts only the work still to run.
+// A run resumed from its run directory says so with how much of the earlier run is done, reads every finished
+// job back, gives the same intervals, and its progress counts only the work still to run.
 #include <filesystem>
 #include <map>
+#include <regex>
 
 #include <gtest/gtest.h>
 
@@ -11,36 +12,69 @@
 namespace hw::relax {
 namespace {
 
+namespace fs = std::filesystem;
+
 struct Recorded {
   std::vector<std::string> messages;
   std::map<std::string, BoundsProgress> last;  // last event of each phase
 };
 
-TEST(Resume, RerunReadsEveryJobBackAndCountsOnlyWhatIsLeft) {
-  const auto ex = SimulateCeroneExample(4, 40, 31.0);
-  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
-  const auto dir = std::filesystem::temp_directory_path() / "hw_resume_test";
-  std::filesystem::remove_all(dir);
-  BoundsOptions options;
-  options.order = 1;
-  options.threads = 1;
-  options.parameters = {"a1"};
-  options.run_dir = dir.string();
-  auto run = [&](Recorded* rec) {
-    return ComputeBounds(options, set, [rec](const BoundsProgress& p) {
+// A small bounds run (one parameter, order 1) with a run directory of its own.
+class Resume : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("hw_resume_test_" + std::string(
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    options_.order = 1;
+    options_.threads = 1;
+    options_.parameters = {"a1"};
+    options_.run_dir = dir_.string();
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  BoundsSummary Run(Recorded* rec) {
+    return ComputeBounds(options_, set_, [rec](const BoundsProgress& p) {
       if (p.total < 0) rec->messages.push_back(p.phase);
       else rec->last[p.phase] = p;
     });
-  };
+  }
+
+  // The finished job files in the run directory (one problem hash below it).
+  std::vector<fs::path> JobFiles() const {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::recursive_directory_iterator(dir_))
+      if (e.path().parent_path().filename() == "jobs" && e.path().extension() == ".json") files.push_back(e.path());
+    return files;
+  }
+
+  const CeroneExample ex_ = SimulateCeroneExample(4, 40, 31.0);
+  const HwOuterSet set_{CeroneExampleStructure(),
+                        HwData{ex_.u, ex_.y, std::vector<double>(ex_.y.size(), ex_.noise_bound), "seeded"}, 1,
+                        std::vector<std::pair<double, double>>(8, {-10.0, 10.0})};
+  fs::path dir_;
+  BoundsOptions options_;
+};
+
+// "resuming: K of M jobs planned so far ..." -> (K, M); (-1, -1) when the line has no such counts.
+std::pair<int, int> ResumeCounts(const std::string& line) {
+  std::smatch m;
+  if (!std::regex_search(line, m, std::regex("^resuming: (\\d+) of (\\d+) jobs planned so far are finished")))
+    return {-1, -1};
+  return {std::stoi(m[1]), std::stoi(m[2])};
+}
+
+TEST_F(Resume, RerunReadsEveryJobBackAndCountsOnlyWhatIsLeft) {
   Recorded first, second;
-  const BoundsSummary a = run(&first);
-  const BoundsSummary b = run(&second);
+  const BoundsSummary a = Run(&first);
+  const int jobs = static_cast<int>(JobFiles().size());
+  const BoundsSummary b = Run(&second);
+  EXPECT_TRUE(first.messages.empty()) << "a fresh run directory resumes nothing";
   EXPECT_EQ(a.jobs_from_cache, 0);
   EXPECT_GT(b.jobs_from_cache, 0);
   EXPECT_EQ(b.sdp_jobs, 0) << "every relaxation job is read back";
   ASSERT_FALSE(second.messages.empty());
-  EXPECT_EQ(second.messages.front().rfind("resuming: ", 0), 0u) << second.messages.front();
+  EXPECT_EQ(ResumeCounts(second.messages.front()), std::make_pair(jobs, jobs)) << second.messages.front();
   for (const char* phase : {"LP screen of orthants", "order 1 relaxations"}) {
     ASSERT_TRUE(first.last.count(phase)) << phase;
     ASSERT_TRUE(second.last.count(phase)) << phase;
@@ -52,7 +86,26 @@ TEST(Resume, RerunReadsEveryJobBackAndCountsOnlyWhatIsLeft) {
     EXPECT_EQ(a.intervals[k].lower.value, b.intervals[k].lower.value);
     EXPECT_EQ(a.intervals[k].upper.value, b.intervals[k].upper.value);
   }
-  std::filesystem::remove_all(dir);
+}
+
+// An interrupted run leaves some planned jobs unfinished: the resume line counts them against the earlier plan,
+// not against what happens to be on disk.
+TEST_F(Resume, ResumeLineCountsFinishedJobsAgainstTheEarlierPlan) {
+  Recorded first, second;
+  const BoundsSummary a = Run(&first);
+  std::vector<fs::path> files = JobFiles();
+  const int planned = static_cast<int>(files.size());
+  ASSERT_GT(planned, 3);
+  for (int k = 0; k < 3; ++k) fs::remove(files[k]);  // as if the earlier run had stopped before these finished
+  const BoundsSummary b = Run(&second);
+  ASSERT_FALSE(second.messages.empty());
+  EXPECT_EQ(ResumeCounts(second.messages.front()), std::make_pair(planned - 3, planned)) << second.messages.front();
+  EXPECT_EQ(static_cast<int>(JobFiles().size()), planned) << "the missing jobs are run again";
+  ASSERT_EQ(a.intervals.size(), b.intervals.size());
+  for (std::size_t k = 0; k < a.intervals.size(); ++k) {
+    EXPECT_EQ(a.intervals[k].lower.value, b.intervals[k].lower.value);
+    EXPECT_EQ(a.intervals[k].upper.value, b.intervals[k].upper.value);
+  }
 }
 
 }  // namespace

@@ -55,6 +55,10 @@ BOUNDS_CASES = [
     ({"noise_bound": 0.0}, ["--noise-bound", 0], "--noise-bound"),
     ({"noise_bound": float("inf")}, ["--noise-bound", "inf"], "--noise-bound"),
     ({"na": 0}, ["--na", 0], "na"),
+    # The prior box: Python's pairs and the CLI's text are checked by one library check (relax::ValidBoxEntry).
+    ({"box": (5, 1)}, ["--box", "5,1"], "--box"),
+    ({"box": {"a1": (3, -3)}}, ["--box", "a1=3,-3"], "--box"),
+    ({"box": {"zz": (0, 1)}}, ["--box", "zz=0,1"], "--box"),
 ]
 
 
