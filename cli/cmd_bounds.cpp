@@ -68,6 +68,7 @@ struct BoundsCliOptions {
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
   bool proper = false, no_cheap = false, no_edge_witnesses = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
+  int row_block_order = -1;
 };
 
 relax::HwData ReadData(const BoundsCliOptions& o) {
@@ -110,6 +111,7 @@ void CheckBoundsOptions(const BoundsCliOptions& o) {
   RequireOption("--threads", [&](std::string* e) { return relax::ValidThreads(o.threads, e); });
   RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
   RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
+  RequireOption("--row-block-order", [&](std::string* e) { return relax::ValidBlockOrderCap(o.row_block_order, e); });
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
@@ -131,6 +133,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.cheap_pass = !o.no_cheap;
   options.edge_witness.enabled = !o.no_edge_witnesses;
   options.contraction_passes = o.contraction_passes;
+  options.generation.block_order_cap = o.row_block_order;
   options.parameters = o.params;
   options.generation.verify.enabled = !o.no_verify;
   if (!o.quiet)  // one line per constraint-generation round, printed by the process that runs the job
@@ -208,6 +211,7 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
     for (std::size_t i = 0; i < names.size(); ++i)
       fmt::print("{}{} in [{:.6g}, {:.6g}]", i ? ", " : "", names[i], b[i].first, b[i].second);
   }
+  fmt::print("\nrelaxation: {}", summary.relaxation);
   fmt::print("\northants: {} total, {} proven empty, {} solved, {} failed; {} relaxation jobs ({} SDP solves, "
              "{} from cache), largest SDP {} moments / {} blocks, median solve {:.2f} s, wall {:.1f} s\n",
              summary.orthants_total, summary.orthants_empty, summary.orthants_solved, summary.orthants_failed,
@@ -311,6 +315,9 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_flag("--no-cheap-pass", o->no_cheap, "solve every orthant at full order (no minimal-order screening)");
   cmd->add_flag("--no-edge-witnesses", o->no_edge_witnesses,
                 "solve every endpoint by SDP, also those a feasible point at the prior box edge settles");
+  cmd->add_option("--row-block-order", o->row_block_order,
+                  "localizing order of the data rows' blocks at most (-1: full order; 1 at order 3: 9x9 blocks, a "
+                  "mixed relaxation between orders 2 and 3, valid and cheaper)");
   cmd->add_option("--contract-passes", o->contraction_passes,
                   "cheap passes repeated in each orthant's contracted box, 0..10 (0 = no box contraction)");
   auto* verify = cmd->add_flag("--verify", o->verify,

@@ -12,6 +12,14 @@
 
 namespace hw::relax {
 
+bool ValidBlockOrderCap(int cap, std::string* error) {
+  if (cap >= -1) return true;
+  if (error)
+    *error = fmt::format("row block order {} is invalid; give -1 (full order) or a localizing order >= 0 (1 at order "
+                         "3: 9x9 blocks)", cap);
+  return false;
+}
+
 bool ConstraintGenerationOptions::IsValid(std::string* error) const {
   auto fail = [&](std::string m) {
     if (error) *error = std::move(m);
@@ -20,7 +28,7 @@ bool ConstraintGenerationOptions::IsValid(std::string* error) const {
   if (order < 0) return fail("order must be >= 0");
   if (max_rounds < 1) return fail("max_rounds must be >= 1");
   if (add_per_round < 1) return fail("add_per_round must be >= 1");
-  if (block_order_cap < -1) return fail("block_order_cap must be -1 (full order) or >= 0");
+  if (!ValidBlockOrderCap(block_order_cap, error)) return false;
   if (!(violation_tolerance > 0)) return fail("violation_tolerance must be > 0");
   if (!(active_fraction >= 0 && active_fraction < 1)) return fail("active_fraction must be in [0, 1)");
   if (!verify.IsValid(error)) return false;

@@ -47,6 +47,9 @@ struct ConstraintGenerationOptions {
   bool IsValid(std::string* error) const;
 };
 
+// A cap of the data rows' localizing order: -1 (full order) or >= 0; otherwise false with the message in *error.
+bool ValidBlockOrderCap(int cap, std::string* error);
+
 // What one round did, for progress lines and reports.
 struct GenerationRound {
   int round = 0;

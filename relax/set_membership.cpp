@@ -52,6 +52,13 @@ std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
   return backends;
 }
 
+// "order 3", or "order 3 with data-row blocks of localizing order <= 1" for a capped (mixed) relaxation.
+std::string RelaxationName(int order, int block_order_cap) {
+  if (block_order_cap < 0) return fmt::format("order {}", order);
+  return fmt::format("order {} with data-row blocks of localizing order <= {} (mixed: between the orders)", order,
+                     block_order_cap);
+}
+
 // Everything that changes the numbers, hashed into the run directory's name.
 std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nlohmann::json* meta) {
   *meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
@@ -180,6 +187,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["horizon"] = horizon;
   j["solver"] = solver;
   j["solver_option"] = solver_option;
+  j["relaxation"] = relaxation;
   j["executor"] = executor;
   nlohmann::json box_j = nlohmann::json::array();
   for (std::size_t i = 0; i < box.size(); ++i)
@@ -311,6 +319,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.horizon = set.horizon();
   summary.solver = SolverForOrder(options.solver, options.order);
   summary.solver_option = options.solver;
+  summary.relaxation = RelaxationName(options.order, options.generation.block_order_cap);
   summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
   summary.box = set.box();
   summary.parameter_names = set.layout().names;

@@ -130,6 +130,9 @@ struct BoundsSummary {
   int order = 0, horizon = 0;
   std::string solver;          // the backend of the reported order's relaxations
   std::string solver_option;   // as asked: "auto" or a backend name
+  // Which relaxation the endpoints are bounds of: "order d", or a mixed one with data-row blocks of a capped
+  // localizing order ("tight" endpoints equal that relaxation's bound over every kept row).
+  std::string relaxation;
   std::string executor;       // e.g. "fork (2 workers)"
   bool worker_rank = false;   // true on MPI worker ranks: they served jobs and hold no result
   std::vector<std::pair<double, double>> box;
