@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   int samples = 1000, horizon = 2, order = 2, add = 20, orthant = -1;
   std::string param = "a1", solver_name = "sdpa";
   bool maximize = false, verify = false, no_linear_rows = false;
-  int contract_rounds = 0, block_order_cap = -1;
+  int contract_rounds = 0, block_order_cap = -1, start_order = 0;
   double gap = 1e-7, feasibility = 1e-7;
   bool keep_prior_box = false;
   double box = 10.0;
@@ -44,6 +44,9 @@ int main(int argc, char** argv) {
   app.add_flag("--no-linear-rows", no_linear_rows, "candidates without a block are left out (not scalar rows)");
   app.add_option("--gap", gap, "the solver's relative gap tolerance");
   app.add_option("--feasibility", feasibility, "the solver's relative feasibility tolerance");
+  app.add_option("--start-order", start_order,
+                 "first solve the job at this (lower) order and start from the rows it found active, as the engine's "
+                 "full pass starts from its cheap pass");
   app.add_option("--block-order-cap", block_order_cap, "data-row blocks of order <= this (-1: full order)");
   app.add_flag("--keep-prior-box", keep_prior_box,
                "scale variables by --box-list but constrain them by the prior box --box only (an affine change of "
@@ -115,11 +118,21 @@ int main(int argc, char** argv) {
   auto solver = hw::sdp::MakeSolver(solver_name);
   fmt::print("N={} n={} order={} orthant {} {} {} ({} candidates), solver {}\n", samples, horizon, order, l,
              maximize ? "max" : "min", param, candidates.size(), solver_name);
+  std::vector<int> initial;
+  if (start_order > 0) {
+    auto cheap = gen;
+    cheap.order = start_order;
+    const auto tc = Clock::now();
+    const auto c = hw::relax::SolveWithConstraintGeneration(cheap, core, candidates, {}, *solver);
+    initial = c.active_set.empty() ? c.working_set : c.active_set;
+    fmt::print("order {} first: bound {:.8f} in {} rounds, {:.2f} s; {} active rows start the order-{} job\n",
+               start_order, c.bound, c.rounds, since(tc), initial.size(), order);
+  }
   fmt::print("{:>5} {:>5} {:>9} {:>9}\n", "round", "K", "elapsed", "");
   const auto t0 = Clock::now();
   int round = 0;
   const auto r = hw::relax::SolveWithConstraintGeneration(
-      gen, core, candidates, {}, *solver, [&](const hw::relax::GenerationRound& r) {
+      gen, core, candidates, initial, *solver, [&](const hw::relax::GenerationRound& r) {
         fmt::print("{:>5} {:>5} {:>9.2f}  {} bound {:.8f}\n", ++round, r.blocks, since(t0), r.status, r.bound);
         std::fflush(stdout);
       });

@@ -119,7 +119,8 @@ std::string SolverText(const relax::BoundsOptions& options) {
   if (options.solver != "auto") return options.solver;
   std::vector<std::string> parts;
   for (int d = std::min(options.order, 2); d <= options.order; ++d)  // the cheap pass runs at order 2 at most
-    parts.push_back(fmt::format("{} at order {}", relax::SolverForOrder("auto", d), d));
+    parts.push_back(fmt::format("{} at order {}",
+                                relax::SolverForOrder("auto", d, options.generation.block_order_cap), d));
   return fmt::format("auto ({})", fmt::join(parts, ", "));
 }
 
@@ -305,7 +306,8 @@ void AddBoundsCommand(CLI::App& app) {
                     ->default_str("minimal");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
   cmd->add_option("--solver", o->solver,
-                  fmt::format("SDP backend: auto (CSDP up to order 2, DSDP from order 3; docs/sdp.md), {}",
+                  fmt::format("SDP backend: auto (DSDP for full-order relaxations of order >= 3, CSDP otherwise; "
+                              "docs/sdp.md), {}",
                               fmt::join(sdp::AvailableSolvers(), ", ")));
   cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)");
   cmd->add_option("--executor", o->executor,

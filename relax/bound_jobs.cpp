@@ -275,7 +275,7 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
       const auto& scaling = set.scaling();
       gen.stop_beyond = (spec.at("stop_beyond").get<double>() - scaling.center[obj.param]) / scaling.radius[obj.param];
     }
-    const std::string backend = SolverForOrder(options.solver, gen.order);
+    const std::string backend = SolverForOrder(options.solver, gen.order, gen.block_order_cap);
     auto solver = sdp::MakeSolver(backend);
     auto other = sdp::MakeSolver(other_solver(backend));
     const std::string label = fmt::format("orthant {} {} {} order {}", l, obj.dir < 0 ? "min" : "max",

@@ -48,7 +48,8 @@ BoundsOptions EngineOptions(const BoundsOptions& options) {
 // The backend of each relaxation order up to the run's order (index 0: order 1).
 std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
   std::vector<std::string> backends;
-  for (int d = 1; d <= options.order; ++d) backends.push_back(SolverForOrder(options.solver, d));
+  for (int d = 1; d <= options.order; ++d)
+    backends.push_back(SolverForOrder(options.solver, d, options.generation.block_order_cap));
   return backends;
 }
 
@@ -137,9 +138,9 @@ bool ValidBoundsSolver(const std::string& name, std::string* error) {
                                  fmt::join(sdp::AvailableSolvers(), ", ")));
 }
 
-std::string SolverForOrder(const std::string& name, int order) {
+std::string SolverForOrder(const std::string& name, int order, int block_order_cap) {
   if (name != "auto") return name;
-  return order <= 2 ? "csdp" : "dsdp";
+  return order >= 3 && block_order_cap < 0 ? "dsdp" : "csdp";
 }
 
 bool BoundsOptions::IsValid(std::string* error) const {
@@ -317,7 +318,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.contraction_passes_run = cheap.contraction_passes_run;
   summary.order = options.order;
   summary.horizon = set.horizon();
-  summary.solver = SolverForOrder(options.solver, options.order);
+  summary.solver = SolverForOrder(options.solver, options.order, options.generation.block_order_cap);
   summary.solver_option = options.solver;
   summary.relaxation = RelaxationName(options.order, options.generation.block_order_cap);
   summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());

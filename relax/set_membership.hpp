@@ -35,7 +35,7 @@ struct BoundsOptions {
   int order = 3;                 // delta of the reported intervals
   bool cheap_pass = true;        // solve the minimal order first to skip objectives (recommended)
   bool lp_screen = true;
-  // "auto" (the backend per relaxation order, SolverForOrder), "csdp", "sdpa" or "dsdp".
+  // "auto" (the backend per relaxation, SolverForOrder), "csdp", "sdpa" or "dsdp".
   std::string solver = "auto";
   bool retry_with_other_solver = true;  // a failed solve is repeated with the other backend (CSDP <-> SDPA; DSDP -> CSDP)
   // Local parallel jobs. CSDP and SDPA are not thread-safe, so jobs run in forked worker processes
@@ -165,9 +165,11 @@ bool ValidThreads(int threads, std::string* error);
 bool ValidContractionPasses(int passes, std::string* error);
 // The backend of a bounds run: "auto" or a name of sdp::AvailableSolvers().
 bool ValidBoundsSolver(const std::string& name, std::string* error);
-// The backend that solves relaxations of this order: `name` itself, or for "auto" the one measured fastest on
-// the engine's relaxations (docs/sdp.md): CSDP up to order 2, DSDP from order 3 on.
-std::string SolverForOrder(const std::string& name, int order);
+// The backend that solves the engine's relaxations of this order with data-row blocks capped at
+// `block_order_cap` (-1: full order): `name` itself, or for "auto" the one measured best on them (docs/sdp.md):
+// DSDP for full-order relaxations of order 3 and more (3002 moments with 45 x 45 blocks), CSDP otherwise
+// (order 2, and order 3 with 9 x 9 data-row blocks, where it ends optimal and DSDP inaccurate).
+std::string SolverForOrder(const std::string& name, int order, int block_order_cap = -1);
 
 BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                             const std::function<void(const BoundsProgress&)>& progress = {});
