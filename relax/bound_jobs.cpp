@@ -179,6 +179,16 @@ std::string BoxHash(const Box& box) {
   return fmt::format("{:016x}", fnv(1469598103934665603ull, nlohmann::json(box).dump()));
 }
 
+PolyProblem OrthantObjectiveCore(const HwOuterSet& set, int l, const Objective& objective) {
+  PolyProblem core;
+  core.num_vars = set.num_vars();
+  core.objective = Polynomial::Variable(set.num_vars(), objective.param);
+  core.maximize = objective.dir > 0;
+  core.inequalities = set.box_constraints();
+  for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(std::move(g));
+  return core;
+}
+
 sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet& prior_set) {
   // Per-process memo of the outer set in each box and of each orthant's data rows (built once, read-only after).
   struct Memo {
@@ -260,12 +270,7 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     }
     // kind == "relax"
     const Objective obj{spec.at("param").get<int>(), spec.at("dir").get<int>()};
-    PolyProblem core;
-    core.num_vars = n;
-    core.objective = Polynomial::Variable(n, obj.param);
-    core.maximize = obj.dir > 0;
-    core.inequalities = set.box_constraints();
-    for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(std::move(g));
+    const PolyProblem core = OrthantObjectiveCore(set, l, obj);
     std::vector<Polynomial> candidates;
     for (int i : spec.at("rows").get<std::vector<int>>()) candidates.push_back(all_rows.at(i).g);
     ConstraintGenerationOptions gen = gen_options;

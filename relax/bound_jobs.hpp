@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "relax/hw_outer_set.hpp"
+#include "relax/moment_relaxation.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/job_executor.hpp"
 
@@ -125,6 +126,10 @@ struct EngineContext {
   EngineCounters& counters;
   ProgressReporter& progress;
 };
+
+// The part of a relaxation job that every round keeps: min (dir -1) / max (+1) of parameter `param` over the box
+// and the sign constraints of orthant l (the data rows are the candidates of constraint generation).
+PolyProblem OrthantObjectiveCore(const HwOuterSet& set, int l, const Objective& objective);
 
 // Builds the job function for (options, set): the outer set in every box a job names and each orthant's data
 // rows are built on first use and kept (before a fork, workers inherit them).

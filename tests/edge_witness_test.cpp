@@ -9,15 +9,10 @@
 #include "core/cerone_example.hpp"
 #include "relax/edge_witness.hpp"
 #include "relax/set_membership.hpp"
+#include "seeded_example.hpp"
 
 namespace hw::relax {
 namespace {
-
-HwOuterSet SeededSet(uint64_t seed, int samples, int horizon, double snr_db, double box) {
-  const auto ex = SimulateCeroneExample(seed, samples, snr_db);
-  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  return HwOuterSet(CeroneExampleStructure(), data, horizon, std::vector<std::pair<double, double>>(8, {-box, box}));
-}
 
 TEST(EdgeWitness, CertifiedSlackAcceptsTheTruthAndRejectsAPointOutside) {
   const HwOuterSet set = SeededSet(5, 60, 2, 31.0, 10.0);
@@ -54,8 +49,7 @@ TEST(EdgeWitness, SettledEndpointsEqualTheRelaxationsAndContainTheTruth) {
   for (std::size_t i = 0; i < with.intervals.size(); ++i) {
     const auto& a = with.intervals[i];
     const auto& b = without.intervals[i];
-    const std::size_t k = std::find(with.parameter_names.begin(), with.parameter_names.end(), a.name) -
-                          with.parameter_names.begin();
+    const std::size_t k = ParameterIndex(with, a.name);
     for (const auto& [x, y, what] : {std::tuple{a.lower, b.lower, "lower"}, std::tuple{a.upper, b.upper, "upper"}}) {
       EXPECT_EQ(x.status, "guaranteed") << a.name << " " << what;
       EXPECT_EQ(x.verification, "verified") << a.name << " " << what;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "relax/basis.hpp"
+#include "relax/bound_jobs.hpp"
 #include "relax/constraint_generation.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "relax/row_reduction.hpp"
@@ -81,12 +82,7 @@ std::pair<HwOuterSet, std::vector<double>> RandomSet(unsigned seed, int samples,
 // checked at its optimal moments (max_violation: the largest relative violation of their localizing matrices).
 ConstraintGenerationResult DenseBound(const HwOuterSet& set, int l, const std::vector<int>& rows,
                                       const std::vector<int>& checked, int k, bool maximize) {
-  PolyProblem core;
-  core.num_vars = set.num_vars();
-  core.objective = Polynomial::Variable(set.num_vars(), k);
-  core.maximize = maximize;
-  core.inequalities = set.box_constraints();
-  for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(g);
+  PolyProblem core = OrthantObjectiveCore(set, l, {k, maximize ? +1 : -1});
   const auto all = set.data_constraints(l);
   for (int i : rows) core.inequalities.push_back(all[i].g);
   std::vector<Polynomial> candidates;

@@ -7,27 +7,18 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
+#include "relax/bound_jobs.hpp"
 #include "relax/constraint_generation.hpp"
 #include "relax/edge_witness.hpp"
 #include "relax/set_membership.hpp"
+#include "seeded_example.hpp"
 
 namespace hw::relax {
 namespace {
 
-HwOuterSet SeededSet(uint64_t seed, int samples, int horizon, double snr_db) {
-  const auto ex = SimulateCeroneExample(seed, samples, snr_db);
-  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  return HwOuterSet(CeroneExampleStructure(), data, horizon, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
-}
-
 // min / max of parameter k over orthant l by constraint generation over every data row, at order 2.
 ConstraintGenerationResult Solve(const HwOuterSet& set, int l, int k, bool maximize, double stop_beyond) {
-  PolyProblem core;
-  core.num_vars = set.num_vars();
-  core.objective = Polynomial::Variable(set.num_vars(), k);
-  core.maximize = maximize;
-  core.inequalities = set.box_constraints();
-  for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(g);
+  const PolyProblem core = OrthantObjectiveCore(set, l, {k, maximize ? +1 : -1});
   std::vector<Polynomial> candidates;
   for (const auto& d : set.data_constraints(l)) candidates.push_back(d.g);
   ConstraintGenerationOptions o;
@@ -112,8 +103,7 @@ TEST(WitnessStop, TheEngineGivesTheEndpointsOfARunWithoutStops) {
   for (std::size_t i = 0; i < with.intervals.size(); ++i) {
     const auto& a = with.intervals[i];
     const auto& b = without.intervals[i];
-    const std::size_t k = std::find(with.parameter_names.begin(), with.parameter_names.end(), a.name) -
-                          with.parameter_names.begin();
+    const std::size_t k = ParameterIndex(with, a.name);
     for (const auto& [x, y] : {std::pair{a.lower, b.lower}, std::pair{a.upper, b.upper}}) {
       EXPECT_EQ(x.status, "guaranteed") << a.name;
       EXPECT_EQ(x.verification, "verified") << a.name;
