@@ -134,7 +134,7 @@ bool ValidContractionPasses(int passes, std::string* error) {
 bool ValidBoundsSolver(const std::string& name, std::string* error) {
   if (name == "auto") return true;
   if (sdp::ValidSolverName(name, nullptr)) return true;
-  return Fail(error, fmt::format("solver '{}' unknown; expected auto (the backend per relaxation order), {}", name,
+  return Fail(error, fmt::format("solver '{}' unknown; expected auto (a backend per relaxation), {}", name,
                                  fmt::join(sdp::AvailableSolvers(), ", ")));
 }
 

@@ -75,7 +75,7 @@ def test_validation_errors_carry_the_cli_message(recording):
     assert str(e.value) == "na must be >= 1" == cli_error(*args, "--na", 0)
     with pytest.raises(ValueError) as e:
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, solver="mosek")
-    assert str(e.value) == ("solver 'mosek' unknown; expected auto (the backend per relaxation order), csdp, sdpa, "
+    assert str(e.value) == ("solver 'mosek' unknown; expected auto (a backend per relaxation), csdp, sdpa, "
                             "dsdp") == cli_error(*args, "--solver", "mosek").removeprefix("--solver: ")
     with pytest.raises(ValueError, match=r"^order 0 is below the minimal order ceil\(\(n\+1\)/2\) = 1 of horizon 1; "):
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=0)
