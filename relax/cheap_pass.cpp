@@ -15,8 +15,8 @@ namespace {
 // orthant) are the blocks the seeds start from. Seeds always run to convergence (no stop at a witnessed value):
 // the other objectives start from their blocks, so the stops change no job's path but their own.
 PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& settled,
-                        const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants, int order, int max_rounds, const std::string& phase,
-                        const std::map<int, std::vector<int>>& seed_rows) {
+                        const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants, int order,
+                        int max_rounds, const std::string& phase, const std::map<int, std::vector<int>>& seed_rows) {
   PassOutcomes out;
   const int num_objectives = static_cast<int>(objectives.size());
   auto is_settled = [&](int l, int j) { return settled.count({l, j}) > 0; };
