@@ -16,6 +16,14 @@
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Where a bound comes from, in scaled units: the solver's float bound, the verified one, and the generation's check.
+void PrintDetails(const char* what, const hw::relax::ConstraintGenerationResult& r) {
+  fmt::print("  {}: bound {:.9f} float {:.9f} primal {:.9f} verified {} origin {} round {} unfinished {} tight {} "
+             "max violation {:.2e} rounds {} status {}\n",
+             what, r.bound, r.float_bound, r.primal_value, r.verification.verified(), hw::relax::ToString(r.origin),
+             r.bound_round, r.bound_from_unfinished_solve, r.tight, r.max_violation, r.rounds, r.last_sdp.message);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -25,7 +33,9 @@ int main(int argc, char** argv) {
   int order = 2, horizon = 2, seed = 1;
   double snr = 31.0;
   std::string solver_name = "sdpa";
-  bool skip_dense = false;
+  bool skip_dense = false, details = false;
+  double violation_tolerance = hw::relax::ConstraintGenerationOptions{}.violation_tolerance;
+  double gap = 1e-5;
   app.add_option("--samples", samples)->delimiter(',');
   app.add_option("--params", params)->delimiter(',');
   app.add_option("--order", order);
@@ -34,6 +44,9 @@ int main(int argc, char** argv) {
   app.add_option("--snr", snr);
   app.add_option("--solver", solver_name);
   app.add_flag("--skip-dense", skip_dense, "only the engine's way (for sizes the dense relaxation cannot reach)");
+  app.add_option("--violation-tol", violation_tolerance, "constraint generation: relative eigenvalue tolerance");
+  app.add_option("--gap", gap, "the SDP's acceptable relative duality gap");
+  app.add_flag("--details", details, "a line per solve: float bound, verification correction, tight, violation");
   CLI11_PARSE(app, argc, argv);
   fmt::print("{:>5} {:>7} {:>4} {:>13} {:>9} {:>13} {:>9} {:>8} {:>9} {:>7} {:>6}\n", "N", "param", "dir", "dense bound",
              "dense s", "engine bound", "engine s", "ratio", "rel diff", "blocks", "rounds");
@@ -62,7 +75,8 @@ int main(int argc, char** argv) {
         core.inequalities = fixed;
         hw::relax::ConstraintGenerationOptions gen;
         gen.order = order;
-        gen.sdp.acceptable_gap = 1e-5;
+        gen.violation_tolerance = violation_tolerance;
+        gen.sdp.acceptable_gap = gap;
         gen.sdp.infeasibility_tolerance = 0.5;
         gen.sdp.retry_with_default_parameters = false;
         auto solver = hw::sdp::MakeSolver(solver_name);
@@ -74,6 +88,7 @@ int main(int argc, char** argv) {
           const auto d = hw::relax::SolveWithConstraintGeneration(gen, dense_problem, {}, {}, *solver);
           dense_s = since(t0);
           dense_bound = d.status == hw::relax::RelaxationStatus::kSolved ? set.scaling().to_original(k, d.bound) : NAN;
+          if (details) PrintDetails("dense", d);
         }
         const auto t1 = Clock::now();
         const auto red = hw::relax::ReduceDataRows({}, all, steps, fixed);
@@ -83,6 +98,7 @@ int main(int argc, char** argv) {
         const double engine_s = since(t1);
         const double engine_bound =
             e.status == hw::relax::RelaxationStatus::kSolved ? set.scaling().to_original(k, e.bound) : NAN;
+        if (details) PrintDetails("engine", e);
         fmt::print("{:>5} {:>7} {:>4} {:>13.7f} {:>9.1f} {:>13.7f} {:>9.1f} {:>8.2f} {:>9.1e} {:>7} {:>6}\n", N, name,
                    dir < 0 ? "min" : "max", dense_bound, dense_s, engine_bound, engine_s, dense_s / engine_s,
                    std::abs(engine_bound - dense_bound) / std::max(1.0, std::abs(dense_bound)), e.working_set.size(),
