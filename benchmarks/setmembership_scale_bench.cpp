@@ -2,7 +2,9 @@
 // speed-up from 1 to 2 local worker processes, and growth with N. A timing harness, not a test; each
 // configuration runs `repeats` times and the median wall time is printed, ratios from the same run.
 //   setmembership_scale_bench [--samples 250,500,1000] [--horizon 1] [--order 1] [--workers 1,2] [--repeats 1]
-//                             [--params a1,...] [--solver csdp]
+//                             [--params a1,...] [--solver auto]
+// Besides the timing table: data rows kept by the exact reduction (summed over live orthants, per step) and the
+// intervals of the last configuration of each N.
 #include <algorithm>
 #include <chrono>
 #include <map>
@@ -13,11 +15,33 @@
 #include "core/cerone_example.hpp"
 #include "relax/set_membership.hpp"
 
+namespace {
+// "kept/rows" per horizon step, summed over the live orthants.
+std::string RowsKept(const hw::relax::BoundsSummary& s) {
+  std::map<int, std::pair<int, int>> per_step;
+  for (const auto& orthant : s.row_reduction)
+    for (const auto& step : orthant.at("per_step")) {
+      auto& [kept, rows] = per_step[step.at("step").get<int>()];
+      kept += step.at("kept").get<int>();
+      rows += step.at("rows").get<int>();
+    }
+  std::string text;
+  for (const auto& [step, kr] : per_step) text += fmt::format("{}{}/{}", text.empty() ? "" : " ", kr.first, kr.second);
+  return text.empty() ? "-" : text;
+}
+
+void PrintIntervals(const hw::relax::BoundsSummary& s) {
+  for (const auto& iv : s.intervals)
+    fmt::print("         {:<7} [{:.6f}, {:.6f}] {} / {}\n", iv.name, iv.lower.value, iv.upper.value, iv.lower.status,
+               iv.upper.status);
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"Set-membership scale harness"};
   std::vector<int> samples{250, 500, 1000}, workers{1, 2};
   int horizon = 1, order = 1, repeats = 1;
-  std::string solver = "csdp";
+  std::string solver = "auto";
   std::vector<std::string> params;
   app.add_option("--samples", samples)->delimiter(',');
   app.add_option("--workers", workers)->delimiter(',');
@@ -29,8 +53,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   fmt::print("paper-001 example, 31 dB, n = {}, delta = {}, solver {}, params {}\n", horizon, order, solver,
              params.empty() ? "all" : fmt::format("{}", fmt::join(params, ",")));
-  fmt::print("{:>6} {:>8} {:>9} {:>9} {:>8} {:>10} {:>9} {:>9} {:>12}\n", "N", "workers", "wall s", "orthants",
-             "jobs", "SDP solves", "median s", "moments", "speed-up");
+  fmt::print("{:>6} {:>8} {:>9} {:>9} {:>8} {:>10} {:>9} {:>9} {:>12} {:>20}\n", "N", "workers", "wall s", "orthants",
+             "jobs", "SDP solves", "median s", "moments", "speed-up", "rows kept per step");
   std::map<int, double> wall_1;
   for (int N : samples) {
     const auto ex = hw::SimulateCeroneExample(1, N);
@@ -53,9 +77,10 @@ int main(int argc, char** argv) {
       std::sort(walls.begin(), walls.end());
       const double wall = walls[walls.size() / 2];
       if (w == workers.front()) wall_1[N] = wall;
-      fmt::print("{:>6} {:>8} {:>9.1f} {:>4}/{:<4} {:>8} {:>10} {:>9.3f} {:>9} {:>12.2f}\n", N, w, wall,
+      fmt::print("{:>6} {:>8} {:>9.1f} {:>4}/{:<4} {:>8} {:>10} {:>9.3f} {:>9} {:>12.2f} {:>20}\n", N, w, wall,
                  s.orthants_total - s.orthants_empty, s.orthants_total, s.sdp_jobs, s.sdp_solves,
-                 s.median_solve_seconds, s.largest_moments, wall_1[N] / wall);
+                 s.median_solve_seconds, s.largest_moments, wall_1[N] / wall, RowsKept(s));
+      if (w == workers.back()) PrintIntervals(s);
       std::fflush(stdout);
     }
   }

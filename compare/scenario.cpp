@@ -37,7 +37,7 @@ const char* kSetMembershipExample = R"({
   "output_inverse_polynomial": [1, 0.8, 3.2],
   "input_range": [-10, 10],
   "noise": {"snr_db": 31},
-  "setmembership": {"samples": 100, "horizon": 1, "order": 1, "box": 10},
+  "setmembership": {"samples": 300, "horizon": 2, "order": 2, "box": 10},
   "esmaeilani": {"segments": 2, "samples": 300, "hold": [3, 15], "grid_f": 12, "grid_g": 12},
   "validation": {"samples": 500, "hold": [1, 10]}
 })";

@@ -60,6 +60,9 @@ TEST(CompareScenario, TruthInSetMembershipParametrisationIsThePapers) {
 TEST(CompareScenario, MethodsOutsideTheirClassAreReportedNotRun) {
   const auto sm = LoadScenario("setmembership-example");
   EXPECT_TRUE(MethodApplies(sm, "setmembership").applies);
+  // The paper's horizon and the lowest order that bounds it: informative intervals, not the prior box.
+  EXPECT_EQ(sm.setmembership.horizon, 2);
+  EXPECT_EQ(sm.setmembership.order, 2);
   EXPECT_TRUE(MethodApplies(sm, "esmaeilani").applies);
   EXPECT_FALSE(MethodApplies(sm, "brouri").applies);
   const auto br = LoadScenario("brouri-backlash");
@@ -130,7 +133,9 @@ std::map<std::string, std::vector<double>> Values(const std::vector<json>& runs,
 
 TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth) {
   auto s = LoadScenario("setmembership-example");
-  s.setmembership.samples = 40;  // n = 1, delta = 1: seconds per run
+  s.setmembership.samples = 40;  // n = 1, delta = 1: seconds per run (the scenario's own n = 2, delta = 2: minutes)
+  s.setmembership.horizon = 1;
+  s.setmembership.order = 1;
   s.esmaeilani.samples = 150;
   s.validation.samples = 200;
   StudyOptions o;
