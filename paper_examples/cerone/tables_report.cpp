@@ -105,6 +105,11 @@ std::string EquivalentMarkdown(const EquivalentSnrResult& e, uint64_t seed) {
   return md + "\n";
 }
 
+template <class T>
+std::string ListText(const std::vector<T>& values) {
+  return values.empty() ? "none" : fmt::format("{}", fmt::join(values, ","));
+}
+
 std::string SettingsMarkdown(const TablesReport& r) {
   const auto& o = r.options;
   return fmt::format(
@@ -113,8 +118,8 @@ std::string SettingsMarkdown(const TablesReport& r) {
       "from the truth, {} pseudo-random starts per objective and {} restart round(s) from other witnesses; every "
       "witness certified by evaluating every inequality of its orthant with a rounding allowance. Outer "
       "intervals marked * have a conservative endpoint; an inner hull marked (box) reaches the prior box.\n\n",
-      r.command, o.samples, fmt::join(o.horizons, ","), fmt::join(o.orders, ","), fmt::join(o.outer_orders, ","),
-      fmt::join(o.outer_snrs, ","), fmt::join(o.seeds, ","), o.box, o.bounds.solver, o.bounds.generation.block_order_cap,
+      r.command, o.samples, ListText(o.horizons), ListText(o.orders), ListText(o.outer_orders), ListText(o.outer_snrs),
+      ListText(o.seeds), o.box, o.bounds.solver, o.bounds.generation.block_order_cap,
       o.bounds.generation.verify.enabled ? "on" : "off", o.inner.random_starts, o.inner.restart_rounds);
 }
 
@@ -215,7 +220,7 @@ std::string PlotData(const std::vector<const TableCase*>& group, const std::vect
       const auto paper = PaperTableInterval(inner.name, c->horizon);
       double scale = paper ? paper->half_width() : inner.half_width();
       if (!(scale > 0)) scale = 1.0;
-      data += fmt::format("{} {}_n{} {} {}", x++, inner.name, c->horizon,
+      data += fmt::format("{} {},n={} {} {}", x++, inner.name, c->horizon,
                           inner.found ? PlotPair(inner.lower, inner.upper, truth, scale) : "NaN NaN",
                           paper ? PlotPair(paper->lower, paper->upper, truth, scale) : "NaN NaN");
       for (int order : orders) {
@@ -241,7 +246,8 @@ std::string PlotScript(const std::string& stem, const std::string& title, const 
                         0.1 + 0.2 * static_cast<double>(i), 7 + 2 * i, 8 + 2 * i, colours[i % 4], orders[i]);
   return fmt::format(
       "set terminal pngcairo size 1200,650\nset output '{}.png'\nset title '{}'\nset ylabel '(value - truth) / "
-      "paper half-width'\nset xtics rotate by -45\nset grid ytics\nset key outside right\nset xzeroaxis lt -1\n{}\n",
+      "paper half-width'\nset termoption noenhanced\nset offsets 0.6, 0.6, 0, 0\nset xtics rotate by -45\n"
+      "set grid ytics\nset key outside right\nset xzeroaxis lt -1\n{}\n",
       stem, title, plot);
 }
 
