@@ -5,7 +5,8 @@
 // paper's interval, the paper's interval cannot be the D^ss(n) interval of OUR noise realisation: it measures
 // how much of a difference from the paper is the data, not the relaxation.
 //   cerone_inner [--samples 1000] [--seed 1] [--horizons 2,3] [--out DIR]
-#include <map>
+#include <cmath>
+#include <filesystem>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -13,21 +14,10 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
+#include "paper_examples/cerone/paper_table.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "relax/inner_points.hpp"
 
-namespace {
-struct PaperRow {
-  double lo, hi;
-};
-// Tables I-III of paper 001 (delta = 3).
-const std::map<std::string, std::map<int, PaperRow>> kPaper = {
-    {"gamma2", {{2, {0.273, 0.547}}, {3, {0.313, 0.476}}}}, {"gamma3", {{2, {-0.234, -0.043}}, {3, {-0.124, -0.071}}}},
-    {"alpha2", {{2, {0.523, 1.147}}, {3, {0.664, 0.931}}}}, {"alpha3", {{2, {2.432, 3.839}}, {3, {2.914, 3.521}}}},
-    {"a1", {{2, {1.556, 1.999}}, {3, {1.612, 1.934}}}},     {"a2", {{2, {0.695, 0.999}}, {3, {0.785, 0.968}}}},
-    {"b1", {{2, {1.138, 2.194}}, {3, {1.345, 1.877}}}},     {"b2", {{2, {1.572, 2.718}}, {3, {1.875, 2.331}}}},
-};
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Inner witnesses of D^ss(n) for the paper-001 example, beside the paper's intervals"};
@@ -63,16 +53,16 @@ int main(int argc, char** argv) {
       const auto lo = hw::relax::LocalExtreme(set, l, k, -1, truth);
       const auto hi = hw::relax::LocalExtreme(set, l, k, +1, truth);
       const double vlo = lo.found ? lo.value : truth[k], vhi = hi.found ? hi.value : truth[k];
-      const auto& p = kPaper.at(name).count(n) ? kPaper.at(name).at(n) : PaperRow{NAN, NAN};
-      const double ratio = 0.5 * (vhi - vlo) / (0.5 * (p.hi - p.lo));
+      const auto p = hw::cerone::PaperTableInterval(name, n).value_or(hw::cerone::PaperInterval{NAN, NAN});
+      const double ratio = 0.5 * (vhi - vlo) / p.half_width();
       fmt::print("  {:<7} inner [{:9.4f}, {:9.4f}]  truth {:7.3f}  paper [{:7.3f}, {:7.3f}]  ratio {:5.2f}{}{}\n", name,
-                 vlo, vhi, truth[k], p.lo, p.hi, ratio, lo.found ? "" : "  (min: " + lo.message + ")",
+                 vlo, vhi, truth[k], p.lower, p.upper, ratio, lo.found ? "" : "  (min: " + lo.message + ")",
                  hi.found ? "" : "  (max: " + hi.message + ")");
       md += fmt::format("| {} | {} | {:.4f} | {:.4f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} |\n", n, name, vlo, vhi,
-                        truth[k], p.lo, p.hi, ratio);
+                        truth[k], p.lower, p.upper, ratio);
       report["rows"].push_back({{"n", n}, {"parameter", name}, {"inner_min", vlo}, {"inner_max", vhi},
                                 {"min_found", lo.found}, {"max_found", hi.found}, {"truth", truth[k]},
-                                {"paper_lo", p.lo}, {"paper_hi", p.hi}, {"min_point", lo.point}, {"max_point", hi.point}});
+                                {"paper_lo", p.lower}, {"paper_hi", p.upper}, {"min_point", lo.point}, {"max_point", hi.point}});
     }
   }
   std::filesystem::create_directories(out);

@@ -45,22 +45,13 @@ double SlackWithAllowance(const Polynomial& g, const std::vector<double>& p) {
   return value - relative * magnitude;
 }
 
-// Deterministic points in a box (a fixed-seed 64-bit LCG: the same starts on every machine).
+// The box centre, then `count` deterministic points in the box (seeded by the orthant).
 std::vector<std::vector<double>> StartsInBox(const Box& box, int count, int orthant) {
   std::vector<std::vector<double>> starts;
   std::vector<double> center;
   for (const auto& [lo, hi] : box) center.push_back(0.5 * (lo + hi));
   starts.push_back(center);
-  std::uint64_t state = 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(orthant + 1);
-  for (int s = 0; s < count; ++s) {
-    std::vector<double> p;
-    for (const auto& [lo, hi] : box) {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      const double r = static_cast<double>(state >> 11) * 0x1.0p-53;
-      p.push_back(lo + r * (hi - lo));
-    }
-    starts.push_back(std::move(p));
-  }
+  for (auto& p : PseudoRandomPointsInBox(box, count, static_cast<std::uint64_t>(orthant + 1))) starts.push_back(std::move(p));
   return starts;
 }
 

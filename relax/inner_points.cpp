@@ -134,6 +134,22 @@ bool InnerPointOptions::IsValid(std::string* error) const {
   return true;
 }
 
+std::vector<std::vector<double>> PseudoRandomPointsInBox(const std::vector<std::pair<double, double>>& box,
+                                                         int count, uint64_t seed) {
+  std::vector<std::vector<double>> points;
+  std::uint64_t state = 0x9E3779B97F4A7C15ull ^ seed;
+  for (int s = 0; s < count; ++s) {
+    std::vector<double> p;
+    for (const auto& [lo, hi] : box) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      const double r = static_cast<double>(state >> 11) * 0x1.0p-53;
+      p.push_back(lo + r * (hi - lo));
+    }
+    points.push_back(std::move(p));
+  }
+  return points;
+}
+
 InnerWitness LocalExtreme(const HwOuterSet& set, int l, int k, int dir, const std::vector<double>& start,
                           const InnerPointOptions& options, const std::vector<int>* rows) {
   std::string error;

@@ -8,7 +8,9 @@
 // and the distance between the two brackets is what a higher relaxation order could still gain. Local
 // optimisation (Ipopt, quasi-Newton, inequalities tightened by a margin so that the returned point is strictly
 // feasible) finds the witnesses; it proves nothing about the outer side and may miss far parts of the set.
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "relax/hw_outer_set.hpp"
@@ -34,6 +36,10 @@ struct InnerWitness {
 // starting from `start` (original units; need not be feasible). `rows` (optional, indices into
 // data_constraints(l)) limits the NLP to those data rows, e.g. the rows kept by the exact reduction, which imply
 // the others; the returned witness is checked against every row all the same.
+// `count` deterministic pseudo-random points in `box` (a fixed-seed 64-bit LCG: the same starts on every machine).
+std::vector<std::vector<double>> PseudoRandomPointsInBox(const std::vector<std::pair<double, double>>& box,
+                                                         int count, uint64_t seed);
+
 InnerWitness LocalExtreme(const HwOuterSet& set, int l, int k, int dir, const std::vector<double>& start,
                           const InnerPointOptions& options = {}, const std::vector<int>* rows = nullptr);
 

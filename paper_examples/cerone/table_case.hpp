@@ -1,0 +1,32 @@
+#pragma once
+// One case of the tables: a realisation of the paper-001 example (SNR, seed, N) at one dynamic horizon n, with
+// its inner hull and the outer intervals of the relaxation orders that were run.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "paper_examples/cerone/inner_hull.hpp"
+#include "relax/set_membership.hpp"
+
+namespace hw::cerone {
+
+struct TableCase {
+  int horizon = 2;
+  double snr_db = 31.0;           // as asked (sets the noise bound)
+  double realised_snr_db = 0.0;   // of the realisation
+  double noise_bound = 0.0;
+  uint64_t seed = 1;
+  int samples = 1000;
+  std::vector<std::string> names;  // every parameter of the layout
+  std::vector<double> truth;       // in layout order
+  InnerHull inner;                 // the wanted parameters
+  std::map<int, relax::BoundsSummary> outer;  // relaxation order -> the engine's run (wanted parameters)
+  // "n=2, 31 dB, seed 1": for messages.
+  std::string label() const;
+};
+
+// The interval of parameter `name` in a run, or null.
+const relax::ParameterInterval* FindInterval(const relax::BoundsSummary& run, const std::string& name);
+
+}  // namespace hw::cerone

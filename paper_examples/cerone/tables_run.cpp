@@ -1,0 +1,89 @@
+#include "paper_examples/cerone/tables_run.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "paper_examples/cerone/paper_table.hpp"
+
+namespace hw::cerone {
+
+relax::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box) {
+  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "cerone2011 example"};
+  return relax::HwOuterSet(relax::CeroneExampleStructure(), data, horizon,
+                           std::vector<std::pair<double, double>>(8, {-box, box}));
+}
+
+std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vector<std::string>& names) {
+  const auto& all = set.layout().names;
+  std::vector<int> indices;
+  for (int k = 0; k < set.num_vars(); ++k)
+    if (names.empty() || std::count(names.begin(), names.end(), all[k])) indices.push_back(k);
+  return indices;
+}
+
+namespace {
+
+// The engine at one order, its run cache in a subdirectory of its own per run.
+relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuterSet& set, const TableCase& c,
+                              int order, const Log& log) {
+  relax::BoundsOptions bounds = options.bounds;
+  bounds.order = order;
+  bounds.parameters = options.params;
+  if (!bounds.run_dir.empty())
+    bounds.run_dir += fmt::format("/N{}_seed{}_snr{:g}_n{}_d{}", c.samples, c.seed, c.snr_db, c.horizon, order);
+  log(fmt::format("{}: outer intervals at order {} ...", c.label(), order));
+  auto summary = relax::ComputeBounds(bounds, set, [&](const relax::BoundsProgress& p) {
+    if (p.done == p.total && p.total > 0)
+      log(fmt::format("  [{}] {} jobs, {:.0f} s", p.phase, p.total, p.elapsed_seconds));
+  });
+  log(fmt::format("{}: order {} done in {:.1f} s", c.label(), order, summary.wall_seconds));
+  return summary;
+}
+
+}  // namespace
+
+TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log) {
+  const auto ex = SimulateCeroneExample(seed, options.samples, snr_db);
+  const auto set = ExampleSet(ex, horizon, options.box);
+  TableCase c;
+  c.horizon = horizon;
+  c.snr_db = snr_db;
+  c.realised_snr_db = ex.snr_db;
+  c.noise_bound = ex.noise_bound;
+  c.seed = seed;
+  c.samples = options.samples;
+  c.names = set.layout().names;
+  c.truth = CeroneExample::TrueParameters();
+  c.inner = ComputeInnerHull(set, c.truth, ParameterIndices(set, options.params), options.inner);
+  log(fmt::format("{}: inner hull from {} witnesses, {} local solves, {:.1f} s", c.label(), c.inner.witnesses,
+                  c.inner.local_solves, c.inner.seconds));
+  for (int order : options.orders)
+    if (options.outer_wanted(order, horizon, snr_db)) c.outer[order] = RunOuter(options, set, c, order, log);
+  return c;
+}
+
+std::vector<TableCase> RunTables(const TablesOptions& options, const Log& log) {
+  std::vector<TableCase> cases;
+  for (double snr : options.snrs)
+    for (uint64_t seed : options.seeds)
+      for (int n : options.horizons) cases.push_back(RunCase(options, n, snr, seed, log));
+  return cases;
+}
+
+std::vector<WidthRatio> InnerWidthRatios(const TablesOptions& options, double snr_db, uint64_t seed, const Log& log) {
+  const auto ex = SimulateCeroneExample(seed, options.samples, snr_db);
+  std::vector<WidthRatio> ratios;
+  for (int n : options.horizons) {
+    const auto set = ExampleSet(ex, n, options.box);
+    const auto hull = ComputeInnerHull(set, CeroneExample::TrueParameters(), ParameterIndices(set, options.params),
+                                       options.inner);
+    for (const auto& iv : hull.intervals)
+      if (const auto paper = PaperTableInterval(iv.name, n); paper && iv.found)
+        ratios.push_back({n, iv.name, iv.half_width(), paper->half_width()});
+  }
+  log(fmt::format("equivalent SNR: {:g} dB -> median log ratio {:.3f}", snr_db, MedianLogRatio(ratios)));
+  return ratios;
+}
+
+}  // namespace hw::cerone

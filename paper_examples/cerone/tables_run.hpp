@@ -1,0 +1,33 @@
+#pragma once
+// Computing the tables' cases: a realisation per (SNR, seed), its inner hulls per horizon, and the engine's outer
+// intervals where TablesOptions asks for them.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/cerone_example.hpp"
+#include "paper_examples/cerone/equivalent_snr.hpp"
+#include "paper_examples/cerone/table_case.hpp"
+#include "paper_examples/cerone/tables_options.hpp"
+
+namespace hw::cerone {
+
+using Log = std::function<void(const std::string&)>;
+
+// D^ss(n) of a realisation in the prior box [-box, box]^8.
+relax::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box);
+
+// Layout indices of the named parameters (empty names: every parameter).
+std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vector<std::string>& names);
+
+// One case: the realisation (seed, SNR), its inner hull at horizon n, and the outer runs wanted there.
+TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log);
+
+// Every case of the tables, in the order (SNR, seed, horizon).
+std::vector<TableCase> RunTables(const TablesOptions& options, const Log& log);
+
+// Inner half-widths over the paper's ones at one SNR (the horizons of `options` the paper prints), for the
+// equivalent-SNR bisection.
+std::vector<WidthRatio> InnerWidthRatios(const TablesOptions& options, double snr_db, uint64_t seed, const Log& log);
+
+}  // namespace hw::cerone
