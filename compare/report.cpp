@@ -8,6 +8,7 @@
 #include "compare/methods.hpp"
 #include "compare/study.hpp"
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 
 namespace hw::compare {
 namespace {
@@ -266,11 +267,8 @@ std::string WritePlots(const std::string& dir, const Scenario& scenario, const s
                     backlash ? "Normalised |G(jw)|/|G(0)|" : "Normalised |G(e^{jw})|/|G(1)|", backlash ? "s" : "sample",
                     backlash ? "set logscale x\n" : "", fplot);
   write_text_atomic(pd + "/plots.gp", gp);
-  const std::string cmd = fmt::format("cd '{}' && gnuplot plots.gp > gnuplot.log 2>&1", pd);
-  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
-    return "gnuplot not found: data and plots/plots.gp written, PNGs not made";
-  if (std::system(cmd.c_str()) != 0) return "gnuplot failed: see plots/gnuplot.log";
-  return "";
+  if (!GnuplotAvailable()) return "gnuplot not found: data and plots/plots.gp written, PNGs not made";
+  return RunGnuplot(pd, "plots.gp");
 }
 
 }  // namespace hw::compare

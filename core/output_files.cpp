@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -77,6 +78,14 @@ void OutputFiles::Commit() {
     for (const auto& tmp : staged) fs::remove(tmp, ec);
     throw std::runtime_error(fmt::format("writing the results failed, nothing was written: {}", e.what()));
   }
+}
+
+bool GnuplotAvailable() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+std::string RunGnuplot(const std::string& dir, const std::string& script) {
+  const std::string cmd = fmt::format("cd '{}' && gnuplot '{}' > '{}.log' 2>&1", dir, script, script);
+  if (std::system(cmd.c_str()) == 0) return "";
+  return fmt::format("gnuplot failed on {}/{}: see {}/{}.log", dir, script, dir, script);
 }
 
 }  // namespace hw

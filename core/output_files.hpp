@@ -15,6 +15,12 @@ void CheckOutputFile(const std::string& path, const std::string& option);
 // is a writable directory).
 void CheckOutputDirectory(const std::string& path, const std::string& option);
 
+// Whether gnuplot is on the PATH (figures are optional: without it, callers keep the data and scripts).
+bool GnuplotAvailable();
+// Runs `script` (a file name inside `dir`) with gnuplot in `dir`, its output to `script`.log there. Returns ""
+// on success, otherwise a message naming the log.
+std::string RunGnuplot(const std::string& dir, const std::string& script);
+
 // Files written at the end of a command: each is staged to path.tmp, then all are renamed into place. A
 // failure while staging removes every staged file, so either all results appear or none do.
 class OutputFiles {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "diagnose/diagnose.hpp"
 
 namespace hw::diagnose {
@@ -292,8 +293,7 @@ std::vector<std::string> WriteReport(const DiagnoseReport& r, const Recording& i
         cond->words, r.region.found ? fmt::format("set arrow from {0:.9g}, graph 0 to {0:.9g}, graph 1 nohead dt 2\n", r.region.threshold) : "");
   }
   put("plots.gp", gp);
-  const std::string cmd = fmt::format("cd '{}' && gnuplot plots.gp > gnuplot.log 2>&1", dir);
-  if (std::system(cmd.c_str()) == 0) {
+  if (RunGnuplot(dir, "plots.gp").empty()) {
     for (const char* f : {"identification.png", "residual_time.png", "validation.png", "residual_vs_condition.png"})
       if (fs::exists(fs::path(dir) / f)) written.push_back((fs::path(dir) / f).string());
   }

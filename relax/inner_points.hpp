@@ -32,14 +32,14 @@ struct InnerWitness {
   std::string message;     // Ipopt's status, or why the point was rejected
 };
 
-// Locally extremises parameter k (dir = -1: min, +1: max) over D^ss(n) within orthant l and the prior box,
-// starting from `start` (original units; need not be feasible). `rows` (optional, indices into
-// data_constraints(l)) limits the NLP to those data rows, e.g. the rows kept by the exact reduction, which imply
-// the others; the returned witness is checked against every row all the same.
 // `count` deterministic pseudo-random points in `box` (a fixed-seed 64-bit LCG: the same starts on every machine).
 std::vector<std::vector<double>> PseudoRandomPointsInBox(const std::vector<std::pair<double, double>>& box,
                                                          int count, uint64_t seed);
 
+// Locally extremises parameter k (dir = -1: min, +1: max) over D^ss(n) within orthant l and the prior box,
+// starting from `start` (original units; need not be feasible). `rows` (optional, indices into
+// data_constraints(l)) limits the NLP to those data rows, e.g. the rows kept by the exact reduction, which imply
+// the others; the returned witness is checked against every row all the same.
 InnerWitness LocalExtreme(const HwOuterSet& set, int l, int k, int dir, const std::vector<double>& start,
                           const InnerPointOptions& options = {}, const std::vector<int>* rows = nullptr);
 

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
+#include "core/output_files.hpp"
 #include "paper_examples/cerone/paper_table.hpp"
 
 namespace hw::cerone {
@@ -268,14 +269,13 @@ std::vector<std::string> WriteTables(const std::string& dir, const TablesReport&
   std::vector<std::string> messages;
   write_text_atomic(dir + "/tables.md", TablesMarkdown(report));
   write_text_atomic(dir + "/tables.json", TablesJson(report).dump(2) + "\n");
-  const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  const bool have_gnuplot = GnuplotAvailable();
   if (!have_gnuplot) messages.push_back("gnuplot not found: the plot data and scripts are in " + dir + " (*.dat, *.gp)");
   for (const auto& plot : TablesPlots(report)) {
     write_text_atomic(dir + "/" + plot.stem + ".dat", plot.data);
     write_text_atomic(dir + "/" + plot.stem + ".gp", plot.script);
     if (!have_gnuplot) continue;
-    const std::string cmd = fmt::format("cd '{}' && gnuplot '{}.gp'", dir, plot.stem);
-    if (std::system(cmd.c_str()) != 0) messages.push_back(fmt::format("gnuplot failed on {}/{}.gp", dir, plot.stem));
+    if (const std::string failed = RunGnuplot(dir, plot.stem + ".gp"); !failed.empty()) messages.push_back(failed);
   }
   messages.push_back(fmt::format("wrote {}/tables.md, tables.json and the plots", dir));
   return messages;
