@@ -224,6 +224,9 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
   if (summary.jobs_stopped_beyond_witness > 0)
     fmt::print("{} relaxation job(s) ended early: their bound passed a certified feasible point's value, so further "
                "rounds could not move the endpoint\n", summary.jobs_stopped_beyond_witness);
+  if (summary.jobs_settled_by_sign > 0)
+    fmt::print("{} relaxation job(s) not run: the orthant's sign constraints already bound them at or beyond a "
+               "certified feasible point's value\n", summary.jobs_settled_by_sign);
   for (const auto& r : summary.row_reduction) {
     std::string steps;
     for (const auto& c : r.at("per_step"))

@@ -32,7 +32,8 @@ OrthantValue ValueOf(const AggregateOptions& options, const JobOutcome& r, const
     v.source = r.unfinished ? "unfinished solve" : r.origin == "earlier round" ? "earlier round" : "final round";
     if (r.beyond_known_value) v.source = "stopped beyond a feasible point's value (cannot move the interval)";
     if (r.status == "skipped") v.source = "cheap order (cannot move the interval)";
-    if (r.origin == "feasible point at the box edge" || r.origin == "box edge reached in another orthant")
+    if (r.origin == "feasible point at the box edge" || r.origin == "box edge reached in another orthant" ||
+        r.origin == "orthant sign constraint")
       v.source = r.origin;
     return v;
   }

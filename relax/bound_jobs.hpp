@@ -93,6 +93,7 @@ class RunCache {
 struct EngineCounters {
   int sdp_jobs = 0, sdp_solves = 0, jobs_from_cache = 0;
   int jobs_stopped_beyond_witness = 0;  // jobs that ended once their bound passed a certified feasible point's
+  int jobs_settled_by_sign = 0;  // jobs not run: the orthant's sign constraints already bound them beyond such a value
   double solve_seconds = 0.0, verify_seconds = 0.0;
   std::vector<double> solve_times;  // per SDP solve (job time / rounds)
   std::size_t largest_moments = 0, largest_blocks = 0;

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "relax/edge_witness.hpp"
 #include "relax/row_reduction.hpp"
 
 namespace hw::relax {
@@ -47,6 +48,13 @@ PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& object
       // The seed's active blocks: its working set less the blocks whose multipliers vanish (they only slow the
       // solves; an objective that needs them gets them back as violated blocks).
       const auto& start = seed_out[k].active_set.empty() ? seed_out[k].working_set : seed_out[k].active_set;
+      // Not the seeds: a seed settled here would change the other objectives' starting blocks.
+      if (auto by_sign = SettleBySignBeyondWitness(ctx.set, *seeds[k].orthant, objectives[j], StopBeyond(witnessed, j))) {
+        out[{seeds[k].orthant->index, j}] = *by_sign;
+        ++ctx.counters.jobs_settled_by_sign;
+        ctx.progress.Done();
+        continue;
+      }
       rest.push_back({seeds[k].orthant, objectives[j], order, start, max_rounds, StopBeyond(witnessed, j)});
       rest_objective.push_back(j);
     }

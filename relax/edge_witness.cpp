@@ -123,7 +123,34 @@ std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector
   return answers;
 }
 
+// The bound of objective `o` that orthant l's box and sign constraints give alone.
+double SignBoxBound(const HwOuterSet& set, const Box& box, int l, const Objective& o) {
+  double bound = EdgeOf(box, o);
+  const auto signs = set.orthant_signs(l);
+  for (std::size_t k = 0; k < set.sign_polynomials().size(); ++k) {
+    const auto& terms = set.sign_polynomials()[k].terms();
+    if (terms.size() != 1) continue;
+    const auto& [e, c] = *terms.begin();
+    if (degree_of(e) != 1 || e[o.param] != 1 || c == 0.0) continue;
+    const int sign_of_x = (c > 0 ? 1 : -1) * signs[k];  // sigma_k * c * x_k >= 0 in orthant l
+    if (o.dir < 0 && sign_of_x > 0) bound = std::max(bound, 0.0);
+    if (o.dir > 0 && sign_of_x < 0) bound = std::min(bound, 0.0);
+  }
+  return bound;
+}
+
 }  // namespace
+
+std::optional<JobOutcome> SettleBySignBeyondWitness(const HwOuterSet& set, const OrthantWork& w, const Objective& o,
+                                                    double witnessed) {
+  if (std::isnan(witnessed)) return std::nullopt;
+  const double sign_bound = SignBoxBound(set, w.box, w.index, o);
+  if (o.dir < 0 ? sign_bound < witnessed : sign_bound > witnessed) return std::nullopt;
+  return AtEdge("skipped", sign_bound, "orthant sign constraint",
+                fmt::format("the orthant's sign constraints bound {} at {:.9g}, at or beyond a certified feasible "
+                            "value {:.9g}: it cannot move the endpoint", set.layout().names[o.param], sign_bound,
+                            witnessed));
+}
 
 EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
                                          const std::vector<Objective>& objectives,

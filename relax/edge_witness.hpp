@@ -9,6 +9,7 @@
 // objective in that orthant exactly, and the interval's endpoint in every orthant (no orthant can go beyond the
 // box), without an SDP. The settled endpoint is the one the full relaxation would give: nothing is loosened.
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,13 @@ double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>
 std::map<int, double> WitnessedExtremes(const HwOuterSet& set, const std::vector<Objective>& objectives,
                                         const std::vector<OrthantWork>& orthants,
                                         const std::map<ObjectiveKey, std::vector<double>>& points);
+
+// Objective `o` in orthant w settled without an SDP when w's box and sign constraints alone bound it at or
+// beyond `witnessed` (a certified feasible value of another part): a sign polynomial c * x_k fixes x_k's sign in
+// the orthant (min x_k >= 0 or max x_k <= 0 there). The relaxation's bound lies beyond that sign bound, the
+// endpoint at or before the value, so the orthant cannot move the endpoint. Empty when it does not apply.
+std::optional<JobOutcome> SettleBySignBeyondWitness(const HwOuterSet& set, const OrthantWork& w, const Objective& o,
+                                                    double witnessed);
 
 EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
                                          const std::vector<Objective>& objectives,

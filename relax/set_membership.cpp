@@ -214,6 +214,7 @@ nlohmann::json BoundsSummary::to_json() const {
                  {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
                  {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache},
                  {"jobs_stopped_beyond_witness", jobs_stopped_beyond_witness},
+                 {"jobs_settled_by_sign", jobs_settled_by_sign},
                  {"edge_witness_settled", edge_witness_settled}, {"edge_witness_solves", edge_witness_solves}};
   j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds},
                  {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds},
@@ -349,6 +350,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.sdp_solves = counters.sdp_solves;
   summary.jobs_from_cache = counters.jobs_from_cache;
   summary.jobs_stopped_beyond_witness = counters.jobs_stopped_beyond_witness;
+  summary.jobs_settled_by_sign = counters.jobs_settled_by_sign;
   summary.solve_seconds = counters.solve_seconds;
   summary.verify_seconds = counters.verify_seconds;
   summary.largest_moments = counters.largest_moments;

@@ -120,6 +120,7 @@ struct BoundsSummary {
   int sdp_solves = 0;         // SDP solves including constraint-generation rounds
   int jobs_from_cache = 0;
   int jobs_stopped_beyond_witness = 0;  // ended early: their bound passed a certified feasible point's value
+  int jobs_settled_by_sign = 0;  // not run: the orthant's sign constraints bound them beyond such a value
   int edge_witness_settled = 0;  // (orthant, objective) pairs settled by a feasible point at the box edge
   int edge_witness_solves = 0;   // local optimisations run to find them
   double edge_witness_seconds = 0.0;

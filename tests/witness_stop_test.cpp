@@ -1,6 +1,7 @@
 // Jobs that end once their bound passes a value a certified feasible point attains (ConstraintGenerationOptions::
-// stop_beyond, relax/edge_witness.hpp WitnessedExtremes): the bound they report stays valid, the value only
-// comes from points that are certified, and a run with the stops gives the endpoints of a run without them.
+// stop_beyond, relax/edge_witness.hpp WitnessedExtremes), and jobs not run because the orthant's sign constraints
+// already bound them beyond such a value: the bound they report stays valid, the value only comes from points
+// that are certified, and a run with the stops gives the endpoints of a run without them.
 #include <algorithm>
 #include <cmath>
 
@@ -83,6 +84,38 @@ TEST(WitnessStop, OnlyCertifiedPointsInsideTheirOrthantsBoxGiveValues) {
   EXPECT_TRUE(WitnessedExtremes(set, objectives, {other}, {{{l ^ 1, 0}, truth}}).empty());
 }
 
+TEST(WitnessStop, AnOrthantWhoseSignBoundIsBeyondAWitnessedValueIsSettledWithoutAnSdp) {
+  const HwOuterSet set = SeededSet(7, 40, 1, 31.0);
+  const auto truth = CeroneExample::TrueParameters();
+  const auto& names = set.layout().names;
+  const int alpha2 = static_cast<int>(std::find(names.begin(), names.end(), "alpha2") - names.begin());
+  const int a1 = static_cast<int>(std::find(names.begin(), names.end(), "a1") - names.begin());
+  const int b1 = static_cast<int>(std::find(names.begin(), names.end(), "b1") - names.begin());
+  const auto& q = set.sign_names();
+  const int alpha2_bit = static_cast<int>(std::find(q.begin(), q.end(), "alpha2") - q.begin());
+  ASSERT_LT(alpha2_bit, static_cast<int>(q.size()));
+  OrthantWork w;  // the truth's orthant: alpha2 >= 0, and Q1_1 = -a1 <= 0, so a1 >= 0
+  w.index = set.orthant_of(truth);
+  w.box = set.box();
+  const auto settled = SettleBySignBeyondWitness(set, w, {alpha2, -1}, -1.0);
+  ASSERT_TRUE(settled.has_value());
+  EXPECT_EQ(settled->status, "skipped");
+  EXPECT_EQ(settled->origin, "orthant sign constraint");
+  EXPECT_EQ(settled->bound, 0.0);
+  EXPECT_EQ(settled->verification, "verified");
+  EXPECT_EQ(SettleBySignBeyondWitness(set, w, {alpha2, -1}, 0.0)->bound, 0.0);  // at the value: cannot move it
+  EXPECT_FALSE(SettleBySignBeyondWitness(set, w, {alpha2, -1}, 0.3));  // the orthant may hold alpha2 < 0.3
+  EXPECT_FALSE(SettleBySignBeyondWitness(set, w, {alpha2, -1}, NAN));
+  EXPECT_FALSE(SettleBySignBeyondWitness(set, w, {alpha2, +1}, 5.0));  // the sign bounds only one side
+  EXPECT_EQ(SettleBySignBeyondWitness(set, w, {a1, -1}, -0.5)->bound, 0.0);  // a sign polynomial -a1
+  EXPECT_FALSE(SettleBySignBeyondWitness(set, w, {b1, -1}, -3.0));  // no sign polynomial: the box edge -10
+  EXPECT_EQ(SettleBySignBeyondWitness(set, w, {b1, -1}, -10.0)->bound, -10.0);
+  OrthantWork negative = w;  // alpha2 <= 0
+  negative.index = w.index ^ (1 << alpha2_bit);
+  EXPECT_EQ(SettleBySignBeyondWitness(set, negative, {alpha2, +1}, 0.8)->bound, 0.0);
+  EXPECT_FALSE(SettleBySignBeyondWitness(set, negative, {alpha2, -1}, -1.0));
+}
+
 TEST(WitnessStop, TheEngineGivesTheEndpointsOfARunWithoutStops) {
   // Horizon 1, order 2: small jobs. The seed of each orthant (min alpha2) never stops, so the stops change no
   // path but the stopped jobs' own: the endpoints are the same numbers.
@@ -95,8 +128,9 @@ TEST(WitnessStop, TheEngineGivesTheEndpointsOfARunWithoutStops) {
   const BoundsSummary with = ComputeBounds(options, set);
   options.edge_witness.stop_beyond_witnesses = false;
   const BoundsSummary without = ComputeBounds(options, set);
-  ASSERT_GT(with.jobs_stopped_beyond_witness, 0) << "the instance no longer exercises the stops";
-  EXPECT_EQ(without.jobs_stopped_beyond_witness, 0);
+  ASSERT_GT(with.jobs_stopped_beyond_witness + with.jobs_settled_by_sign, 0)
+      << "the instance no longer exercises the stops";
+  EXPECT_EQ(without.jobs_stopped_beyond_witness + without.jobs_settled_by_sign, 0);
   EXPECT_LT(with.sdp_solves, without.sdp_solves);
   CompareEndpoints(with, without, [](const std::string& name, std::size_t, const Endpoint& x, const Endpoint& y, bool) {
     EXPECT_NEAR(x.value, y.value, 1e-9 * (1 + std::abs(y.value))) << name;
