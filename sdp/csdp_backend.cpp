@@ -1,4 +1,5 @@
 #include "sdp/csdp_backend.hpp"
+#include "sdp/csdp_schur.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -246,7 +247,7 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     std::free(workvec);
   }
   out.details = {{"return_code", ret}, {"pobj", pobj}, {"dobj", dobj}, {"iterations", out.iterations},
-                 {"lock_wait_seconds", wait_seconds}};
+                 {"lock_wait_seconds", wait_seconds}, {"schur_assembly", CsdpSchurAssembly()}};
 
   // CSDP 6.2 return codes (CSDP user's guide; its primal is max tr(CX), A(X) = a, X >= 0):
   //   0 solved; 1 primal infeasible = no X = our problem unbounded below (y holds the ray);

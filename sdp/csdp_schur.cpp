@@ -1,0 +1,185 @@
+#include "sdp/csdp_schur.hpp"
+
+#include <algorithm>
+#include <vector>
+
+#include <Eigen/Dense>
+
+extern "C" {
+#include <csdp/declarations.h>
+}
+
+// CSDP's Schur complement O_ij = tr(A_i Z^-1 A_j X), assembled per block in a form that suits the moment
+// relaxations' LMIs. CSDP's own op_o() visits every pair of constraints that share a block and sums products of
+// their entries; a 9 x 9 localizing block touches hundreds to a thousand moments, so most of a solve went into
+// those pair loops (77-86 % of CSDP's time on the set-membership relaxations, perf). Here a block's
+// contribution is A_B K_B A_B^T with A_B sparse (constraints x packed entries) and K_B dense, which costs
+// (constraints in the block) x (nonzeros of the block) instead of (constraints in the block)^2 x (entries per
+// constraint)^2. Linked before the static libsdp.a (sdp/CMakeLists.txt), this definition replaces the archive's
+// op_o() as initparams() does (csdp_backend.cpp); only the upper triangle of O is read by CSDP.
+namespace hw::sdp {
+namespace {
+
+using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor>;
+
+// A block at most this size gets the dense packed kernel K_B (P x P, P = n (n + 1) / 2); larger blocks (the
+// order-3 moment matrix, 165 x 165) get W = Z^-1 A_i X per constraint.
+constexpr int kPackedKernelMaxSize = 46;
+
+// One constraint's entries in one block, positions 0-based.
+struct BlockConstraint {
+  int constraint = 0;  // 1-based, as CSDP numbers them
+  std::vector<int> row, col;
+  std::vector<double> value;
+};
+
+std::vector<BlockConstraint> ConstraintsOfBlock(struct sparseblock* first) {
+  std::vector<BlockConstraint> out;
+  for (struct sparseblock* p = first; p != nullptr; p = p->nextbyblock) {
+    BlockConstraint c;
+    c.constraint = p->constraintnum;
+    for (int e = 1; e <= p->numentries; ++e) {
+      c.row.push_back(std::min(p->iindices[e], p->jindices[e]) - 1);
+      c.col.push_back(std::max(p->iindices[e], p->jindices[e]) - 1);
+      c.value.push_back(p->entries[e]);
+    }
+    out.push_back(std::move(c));
+  }
+  // Ascending constraint numbers: a block's pairs (i <= j) then fill column j of O's upper triangle in order.
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.constraint < b.constraint; });
+  return out;
+}
+
+class SchurMatrix {
+ public:
+  SchurMatrix(int k, double* o) : k_(k), ld_(k % 2 == 0 ? k + 1 : k), o_(o) {}
+  void Zero() { std::fill(o_, o_ + static_cast<long>(ld_) * k_, 0.0); }
+  // Adds v to O(i, j) and (for i != j) O(j, i), stored in the upper triangle; i, j 1-based.
+  void Add(int i, int j, double v) {
+    if (i > j) std::swap(i, j);
+    o_[(static_cast<long>(j) - 1) * ld_ + i - 1] += v;
+  }
+
+ private:
+  int k_, ld_;
+  double* o_;
+};
+
+// Diagonal (LP) block: O_ij += sum_p A_i[p] A_j[p] Z^-1[p] X[p], by position.
+void AddDiagonalBlock(const std::vector<BlockConstraint>& cs, const double* zi, const double* x, int n,
+                      SchurMatrix& o) {
+  std::vector<std::vector<std::pair<int, double>>> at(n);
+  for (const auto& c : cs)
+    for (std::size_t e = 0; e < c.value.size(); ++e) at[c.row[e]].push_back({c.constraint, c.value[e]});
+  for (int p = 0; p < n; ++p) {
+    const double d = zi[p + 1] * x[p + 1];
+    const auto& list = at[p];
+    for (std::size_t a = 0; a < list.size(); ++a)
+      for (std::size_t b = a; b < list.size(); ++b) o.Add(list[a].first, list[b].first, list[a].second * list[b].second * d);
+  }
+}
+
+// Packed index of (r, c), r <= c, 0-based.
+int Packed(int r, int c) { return r + c * (c + 1) / 2; }
+
+// Small matrix block: K(u, v) = tr(E_u Z^-1 E_v X) over packed positions u = (p, q), v = (r, s), with E_u the
+// symmetric unit matrix of u; then U = A_B K and O_ij += A_j . U_i.
+void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& zi, const Matrix& x, SchurMatrix& o) {
+  const int n = static_cast<int>(zi.rows());
+  const int packed = n * (n + 1) / 2;
+  std::vector<int> pr(packed), pc(packed);
+  for (int c = 0; c < n; ++c)
+    for (int r = 0; r <= c; ++r) pr[Packed(r, c)] = r, pc[Packed(r, c)] = c;
+  Matrix kernel(packed, packed);
+  for (int v = 0; v < packed; ++v) {
+    const int r = pr[v], s = pc[v];
+    for (int u = 0; u <= v; ++u) {
+      const int p = pr[u], q = pc[u];
+      // Orientations (a, b) of u and (c, d) of v: sum of Z^-1[b, c] X[d, a].
+      double sum = zi(q, r) * x(s, p);
+      if (p != q) sum += zi(p, r) * x(s, q);
+      if (r != s) sum += zi(q, s) * x(r, p);
+      if (p != q && r != s) sum += zi(p, s) * x(r, q);
+      kernel(u, v) = kernel(v, u) = sum;
+    }
+  }
+  // U = A_B K (constraints x packed positions): column v of U holds (K A_i)[v] for every constraint i.
+  const int m = static_cast<int>(cs.size());
+  Matrix u = Matrix::Zero(m, packed);
+  for (int i = 0; i < m; ++i)
+    for (std::size_t e = 0; e < cs[i].value.size(); ++e)
+      u.row(i) += cs[i].value[e] * kernel.row(Packed(cs[i].row[e], cs[i].col[e]));
+  // Column j of the block's contribution, rows i <= j: sum over A_j's entries of value * U(:, position).
+  Eigen::VectorXd column(m);
+  for (int j = 0; j < m; ++j) {
+    column.head(j + 1).setZero();
+    for (std::size_t e = 0; e < cs[j].value.size(); ++e)
+      column.head(j + 1) += cs[j].value[e] * u.col(Packed(cs[j].row[e], cs[j].col[e])).head(j + 1);
+    for (int i = 0; i <= j; ++i) o.Add(cs[i].constraint, cs[j].constraint, column[i]);
+  }
+}
+
+// Large matrix block: per constraint i, W = Z^-1 A_i X from the rows A_i touches, then O_ij += A_j . W.
+void AddLargeMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& zi, const Matrix& x, SchurMatrix& o) {
+  const int n = static_cast<int>(zi.rows());
+  const int m = static_cast<int>(cs.size());
+  Matrix w(n, n), t, zsub;
+  std::vector<int> rows, slot(n, -1);
+  for (int i = 0; i < m; ++i) {
+    const auto& a = cs[i];
+    rows.clear();
+    for (std::size_t e = 0; e < a.value.size(); ++e)
+      for (int r : {a.row[e], a.col[e]})
+        if (slot[r] < 0) slot[r] = static_cast<int>(rows.size()), rows.push_back(r);
+    const int nr = static_cast<int>(rows.size());
+    t.setZero(nr, n);  // (A_i X) restricted to the rows A_i touches
+    for (std::size_t e = 0; e < a.value.size(); ++e) {
+      const int p = a.row[e], q = a.col[e];
+      t.row(slot[p]) += a.value[e] * x.row(q);
+      if (p != q) t.row(slot[q]) += a.value[e] * x.row(p);
+    }
+    zsub.resize(n, nr);
+    for (int r = 0; r < nr; ++r) zsub.col(r) = zi.col(rows[r]);
+    w.noalias() = zsub * t;
+    for (int r : rows) slot[r] = -1;
+    for (int j = i; j < m; ++j) {
+      double sum = 0.0;
+      for (std::size_t e = 0; e < cs[j].value.size(); ++e) {
+        const int r = cs[j].row[e], s = cs[j].col[e];
+        sum += cs[j].value[e] * (r == s ? w(r, s) : w(r, s) + w(s, r));
+      }
+      o.Add(a.constraint, cs[j].constraint, sum);
+    }
+  }
+}
+
+Matrix Dense(const struct blockrec& block) {
+  const int n = block.blocksize;
+  return Eigen::Map<const Matrix>(block.data.mat, n, n);
+}
+
+}  // namespace
+
+const char* CsdpSchurAssembly() { return "hwbounds block kernels (sdp/csdp_schur.cpp)"; }
+
+}  // namespace hw::sdp
+
+extern "C" void op_o(int k, struct constraintmatrix* /*constraints*/, struct sparseblock** byblocks,
+                     struct blockmatrix Zi, struct blockmatrix X, double* O, struct blockmatrix /*work1*/,
+                     struct blockmatrix /*work2*/) {
+  using namespace hw::sdp;
+  SchurMatrix o(k, O);
+  o.Zero();
+  for (int b = 1; b <= X.nblocks; ++b) {
+    if (byblocks[b] == nullptr) continue;
+    const auto cs = ConstraintsOfBlock(byblocks[b]);
+    const struct blockrec& xb = X.blocks[b];
+    if (xb.blockcategory == DIAG) {
+      AddDiagonalBlock(cs, Zi.blocks[b].data.vec, xb.data.vec, xb.blocksize, o);
+    } else if (xb.blocksize <= kPackedKernelMaxSize) {
+      AddSmallMatrixBlock(cs, Dense(Zi.blocks[b]), Dense(xb), o);
+    } else {
+      AddLargeMatrixBlock(cs, Dense(Zi.blocks[b]), Dense(xb), o);
+    }
+  }
+}
