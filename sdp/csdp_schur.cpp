@@ -105,10 +105,12 @@ void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& z
   }
   // U = A_B K (constraints x packed positions): column v of U holds (K A_i)[v] for every constraint i.
   const int m = static_cast<int>(cs.size());
-  Matrix u = Matrix::Zero(m, packed);
+  // Built column by column as K A_i (contiguous: K is symmetric), then transposed once.
+  Matrix ut = Matrix::Zero(packed, m);
   for (int i = 0; i < m; ++i)
     for (std::size_t e = 0; e < cs[i].value.size(); ++e)
-      u.row(i) += cs[i].value[e] * kernel.row(Packed(cs[i].row[e], cs[i].col[e]));
+      ut.col(i) += cs[i].value[e] * kernel.col(Packed(cs[i].row[e], cs[i].col[e]));
+  const Matrix u = ut.transpose();
   // Column j of the block's contribution, rows i <= j: sum over A_j's entries of value * U(:, position).
   Eigen::VectorXd column(m);
   for (int j = 0; j < m; ++j) {
