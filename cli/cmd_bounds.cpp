@@ -309,8 +309,7 @@ void AddBoundsCommand(CLI::App& app) {
                     ->default_str("minimal");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
   cmd->add_option("--solver", o->solver,
-                  fmt::format("SDP backend: auto (DSDP for full-order relaxations of order >= 3, CSDP otherwise; "
-                              "docs/sdp.md), {}",
+                  fmt::format("SDP backend: auto (CSDP, measured fastest at orders 2 and 3; docs/sdp.md), {}",
                               fmt::join(sdp::AvailableSolvers(), ", ")));
   cmd->add_option("--threads", o->threads, "parallel SDP jobs on this machine (worker processes; 0 = one per core)");
   cmd->add_option("--executor", o->executor,

@@ -138,9 +138,8 @@ bool ValidBoundsSolver(const std::string& name, std::string* error) {
                                  fmt::join(sdp::AvailableSolvers(), ", ")));
 }
 
-std::string SolverForOrder(const std::string& name, int order, int block_order_cap) {
-  if (name != "auto") return name;
-  return order >= 3 && block_order_cap < 0 ? "dsdp" : "csdp";
+std::string SolverForOrder(const std::string& name, int /*order*/, int /*block_order_cap*/) {
+  return name == "auto" ? "csdp" : name;
 }
 
 bool BoundsOptions::IsValid(std::string* error) const {

@@ -162,6 +162,10 @@ Matrix Dense(const struct blockrec& block) {
 
 }  // namespace
 
+#ifdef HW_LIBSDP_SCHUR
+const char* CsdpSchurAssembly() { return "libsdp op_o (HWBOUNDS_LIBSDP_SCHUR)"; }
+}  // namespace hw::sdp
+#else
 const char* CsdpSchurAssembly() { return "hwbounds block kernels (sdp/csdp_schur.cpp)"; }
 
 }  // namespace hw::sdp
@@ -185,3 +189,4 @@ extern "C" void op_o(int k, struct constraintmatrix* /*constraints*/, struct spa
     }
   }
 }
+#endif  // HW_LIBSDP_SCHUR
