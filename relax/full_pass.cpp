@@ -35,8 +35,9 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
       for (const auto& w : orthants) {
         if (w.empty() || full.count({w.index, o})) continue;
         const auto& c = cheap.at({w.index, o});
-        // A failed cheap job cannot be used to skip: it must be solved.
-        const double v = c.status == "solved" ? c.bound : (dir < 0 ? -INFINITY : INFINITY);
+        // A failed cheap job cannot be used to skip: it must be solved. A skipped one carries a valid bound (the
+        // box edge, or the orthant's sign bound beyond a witnessed value).
+        const double v = c.status == "solved" || c.status == "skipped" ? c.bound : (dir < 0 ? -INFINITY : INFINITY);
         // The endpoint is at least as extreme as the finished jobs' bounds and as a witnessed value.
         const double witness = StopBeyond(witnessed, o);
         const bool can_move = (std::isnan(current[o]) || (dir < 0 ? v < current[o] : v > current[o])) &&
