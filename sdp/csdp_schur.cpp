@@ -82,9 +82,9 @@ void AddDiagonalBlock(const std::vector<BlockConstraint>& cs, const double* zi, 
 // Packed index of (r, c), r <= c, 0-based.
 int Packed(int r, int c) { return r + c * (c + 1) / 2; }
 
-// Small matrix block: K(u, v) = tr(E_u Z^-1 E_v X) over packed positions u = (p, q), v = (r, s), with E_u the
-// symmetric unit matrix of u; then U = A_B K and O_ij += A_j . U_i.
-void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& zi, const Matrix& x, SchurMatrix& o) {
+// K(u, v) = tr(E_u Z^-1 E_v X) over packed positions u = (p, q), v = (r, s) of an n x n block, with E_u the
+// symmetric unit matrix of u.
+Matrix PackedKernel(const Matrix& zi, const Matrix& x) {
   const int n = static_cast<int>(zi.rows());
   const int packed = n * (n + 1) / 2;
   std::vector<int> pr(packed), pc(packed);
@@ -103,9 +103,16 @@ void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& z
       kernel(u, v) = kernel(v, u) = sum;
     }
   }
-  // U = A_B K (constraints x packed positions): column v of U holds (K A_i)[v] for every constraint i.
+  return kernel;
+}
+
+// Small matrix block: U = A_B K, then O_ij += A_j . U_i.
+void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& zi, const Matrix& x, SchurMatrix& o) {
+  const Matrix kernel = PackedKernel(zi, x);
+  const int packed = static_cast<int>(kernel.rows());
+  // U = A_B K (constraints x packed positions), built column by column as K A_i (contiguous: K is symmetric),
+  // then transposed once.
   const int m = static_cast<int>(cs.size());
-  // Built column by column as K A_i (contiguous: K is symmetric), then transposed once.
   Matrix ut = Matrix::Zero(packed, m);
   for (int i = 0; i < m; ++i)
     for (std::size_t e = 0; e < cs[i].value.size(); ++e)
