@@ -21,6 +21,8 @@ namespace hw::sdp {
 namespace {
 
 using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor>;
+// CSDP's dense blocks, read in place (Fortran order).
+using BlockView = Eigen::Map<const Matrix>;
 
 // A block at most this size gets the dense packed kernel K_B (P x P, P = n (n + 1) / 2); larger blocks (the
 // order-3 moment matrix, 165 x 165) get W = Z^-1 A_i X per constraint.
@@ -84,7 +86,7 @@ int Packed(int r, int c) { return r + c * (c + 1) / 2; }
 
 // K(u, v) = tr(E_u Z^-1 E_v X) over packed positions u = (p, q), v = (r, s) of an n x n block, with E_u the
 // symmetric unit matrix of u.
-Matrix PackedKernel(const Matrix& zi, const Matrix& x) {
+Matrix PackedKernel(const BlockView& zi, const BlockView& x) {
   const int n = static_cast<int>(zi.rows());
   const int packed = n * (n + 1) / 2;
   std::vector<int> pr(packed), pc(packed);
@@ -107,7 +109,8 @@ Matrix PackedKernel(const Matrix& zi, const Matrix& x) {
 }
 
 // Small matrix block: U = A_B K, then O_ij += A_j . U_i.
-void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& zi, const Matrix& x, SchurMatrix& o) {
+void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const BlockView& zi, const BlockView& x,
+                         SchurMatrix& o) {
   const Matrix kernel = PackedKernel(zi, x);
   const int packed = static_cast<int>(kernel.rows());
   // U = A_B K (constraints x packed positions), built column by column as K A_i (contiguous: K is symmetric),
@@ -129,7 +132,8 @@ void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& z
 }
 
 // Large matrix block: per constraint i, W = Z^-1 A_i X from the rows A_i touches, then O_ij += A_j . W.
-void AddLargeMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& zi, const Matrix& x, SchurMatrix& o) {
+void AddLargeMatrixBlock(const std::vector<BlockConstraint>& cs, const BlockView& zi, const BlockView& x,
+                         SchurMatrix& o) {
   const int n = static_cast<int>(zi.rows());
   const int m = static_cast<int>(cs.size());
   Matrix w(n, n), t, zsub;
@@ -162,9 +166,8 @@ void AddLargeMatrixBlock(const std::vector<BlockConstraint>& cs, const Matrix& z
   }
 }
 
-Matrix Dense(const struct blockrec& block) {
-  const int n = block.blocksize;
-  return Eigen::Map<const Matrix>(block.data.mat, n, n);
+BlockView View(const struct blockrec& block) {
+  return BlockView(block.data.mat, block.blocksize, block.blocksize);
 }
 
 }  // namespace
@@ -190,9 +193,9 @@ extern "C" void op_o(int k, struct constraintmatrix* /*constraints*/, struct spa
     if (xb.blockcategory == DIAG) {
       AddDiagonalBlock(cs, Zi.blocks[b].data.vec, xb.data.vec, xb.blocksize, o);
     } else if (xb.blocksize <= kPackedKernelMaxSize) {
-      AddSmallMatrixBlock(cs, Dense(Zi.blocks[b]), Dense(xb), o);
+      AddSmallMatrixBlock(cs, View(Zi.blocks[b]), View(xb), o);
     } else {
-      AddLargeMatrixBlock(cs, Dense(Zi.blocks[b]), Dense(xb), o);
+      AddLargeMatrixBlock(cs, View(Zi.blocks[b]), View(xb), o);
     }
   }
 }
