@@ -79,10 +79,9 @@ double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>
   return m;
 }
 
-std::map<int, double> WitnessedExtremes(const HwOuterSet& set, const std::vector<Objective>& objectives,
-                                        const std::vector<OrthantWork>& orthants,
-                                        const std::map<ObjectiveKey, std::vector<double>>& points) {
-  std::map<int, double> extremes;
+std::vector<FeasiblePoint> CertifiedFeasiblePoints(const HwOuterSet& set, const std::vector<OrthantWork>& orthants,
+                                                   const std::map<ObjectiveKey, std::vector<double>>& points) {
+  std::vector<FeasiblePoint> certified;
   for (const auto& [key, p] : points) {
     const OrthantWork* w = nullptr;
     for (const auto& o : orthants)
@@ -90,15 +89,43 @@ std::map<int, double> WitnessedExtremes(const HwOuterSet& set, const std::vector
     if (!w || w->empty() || p.size() != w->box.size()) continue;
     bool inside = true;
     for (std::size_t i = 0; i < p.size(); ++i) inside = inside && w->box[i].first <= p[i] && p[i] <= w->box[i].second;
-    if (!inside || !(CertifiedMinSlack(set, key.first, p) >= 0)) continue;
-    for (std::size_t j = 0; j < objectives.size(); ++j) {
-      const double v = p[objectives[j].param];
-      const auto it = extremes.find(static_cast<int>(j));
-      if (it == extremes.end() || (objectives[j].dir < 0 ? v < it->second : v > it->second))
-        extremes[static_cast<int>(j)] = v;
-    }
+    if (!inside) continue;
+    const double slack = CertifiedMinSlack(set, key.first, p);
+    if (slack >= 0) certified.push_back({key.first, p, slack});
   }
+  return certified;
+}
+
+namespace {
+
+// Index of the first point most extreme in objective o's parameter; -1 without points.
+int MostExtreme(const Objective& o, const std::vector<FeasiblePoint>& points) {
+  int best = -1;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    const double v = points[i].point[o.param];
+    if (best < 0 || (o.dir < 0 ? v < points[best].point[o.param] : v > points[best].point[o.param])) best = i;
+  }
+  return best;
+}
+
+}  // namespace
+
+std::map<int, double> WitnessedExtremes(const std::vector<Objective>& objectives,
+                                        const std::vector<FeasiblePoint>& points) {
+  std::map<int, double> extremes;
+  for (std::size_t j = 0; j < objectives.size(); ++j)
+    if (const int i = MostExtreme(objectives[j], points); i >= 0)
+      extremes[static_cast<int>(j)] = points[i].point[objectives[j].param];
   return extremes;
+}
+
+std::vector<FeasiblePoint> ExtremeFeasiblePoints(const std::vector<Objective>& objectives,
+                                                 const std::vector<FeasiblePoint>& points) {
+  std::vector<FeasiblePoint> extreme;
+  std::set<int> taken;
+  for (const auto& o : objectives)
+    if (const int i = MostExtreme(o, points); i >= 0 && taken.insert(i).second) extreme.push_back(points[i]);
+  return extreme;
 }
 
 namespace {
@@ -224,7 +251,9 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
     if (o.dir < 0 ? p[o.param] < current[o.param] : p[o.param] > current[o.param]) current = p;
   }
 
-  if (options.stop_beyond_witnesses) result.witnessed = WitnessedExtremes(set, objectives, orthants, found);
+  const std::vector<FeasiblePoint> certified = CertifiedFeasiblePoints(set, orthants, found);
+  result.feasible_points = ExtremeFeasiblePoints(objectives, certified);
+  if (options.stop_beyond_witnesses) result.witnessed = WitnessedExtremes(objectives, certified);
   // Certification here, whatever the workers said: the point must attain the edge and satisfy every row.
   std::map<int, int> edge_reached_in;  // objective -> orthant whose point attains the prior box edge
   for (const auto& [key, point] : found) {

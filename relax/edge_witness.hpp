@@ -31,6 +31,9 @@ struct EdgeWitnessResult {
   // any live orthant, inside its box). The endpoint is at least that extreme, so an orthant whose valid bound
   // is already beyond it cannot move the endpoint (relax/constraint_generation.hpp, stop_beyond).
   std::map<int, double> witnessed;
+  // The certified feasible points most extreme in some objective's parameter (one per point, in objective
+  // order): inner witnesses a user can check, and the inner side of each interval.
+  std::vector<FeasiblePoint> feasible_points;
   int local_solves = 0;
   double seconds = 0.0;
 };
@@ -39,11 +42,18 @@ struct EdgeWitnessResult {
 // bound on its floating-point evaluation error; >= 0 means p lies in D^ss(n) of orthant l despite rounding.
 double CertifiedMinSlack(const HwOuterSet& set, int l, const std::vector<double>& p);
 
-// Per objective, the most extreme value of its parameter over the points that are certified feasible points of
-// their orthant (inside the orthant's box, CertifiedMinSlack >= 0); objectives without one are absent.
-std::map<int, double> WitnessedExtremes(const HwOuterSet& set, const std::vector<Objective>& objectives,
-                                        const std::vector<OrthantWork>& orthants,
-                                        const std::map<ObjectiveKey, std::vector<double>>& points);
+// The points that are certified feasible points of their orthant (a live orthant, inside its box,
+// CertifiedMinSlack >= 0), in key order.
+std::vector<FeasiblePoint> CertifiedFeasiblePoints(const HwOuterSet& set, const std::vector<OrthantWork>& orthants,
+                                                   const std::map<ObjectiveKey, std::vector<double>>& points);
+
+// Per objective, the most extreme value of its parameter over `points`; objectives without one are absent.
+std::map<int, double> WitnessedExtremes(const std::vector<Objective>& objectives,
+                                        const std::vector<FeasiblePoint>& points);
+
+// The first point most extreme in each objective's parameter, without repeats, in objective order.
+std::vector<FeasiblePoint> ExtremeFeasiblePoints(const std::vector<Objective>& objectives,
+                                                 const std::vector<FeasiblePoint>& points);
 
 // Objective `o` in orthant w settled without an SDP when w's box and sign constraints alone bound it at or
 // beyond `witnessed` (a certified feasible value of another part): a sign polynomial c * x_k fixes x_k's sign in

@@ -32,6 +32,14 @@ struct InnerWitness {
   std::string message;     // Ipopt's status, or why the point was rejected
 };
 
+// A point of D^ss(n) in orthant `orthant` checked by evaluating every inequality of that orthant with a
+// rounding-error allowance (relax::CertifiedMinSlack >= 0): the exact interval of every parameter reaches it.
+struct FeasiblePoint {
+  int orthant = -1;
+  std::vector<double> point;  // original units, inside the orthant's box
+  double certified_min_slack = 0.0;
+};
+
 // `count` deterministic pseudo-random points in `box` (a fixed-seed 64-bit LCG: the same starts on every machine).
 std::vector<std::vector<double>> PseudoRandomPointsInBox(const std::vector<std::pair<double, double>>& box,
                                                          int count, uint64_t seed);

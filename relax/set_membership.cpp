@@ -54,8 +54,12 @@ std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
 }
 
 // "order 3", or "order 3 with data-row blocks of localizing order <= 1" for a capped (mixed) relaxation.
-std::string RelaxationName(int order, int block_order_cap) {
-  if (block_order_cap < 0) return fmt::format("order {}", order);
+// "order d", or the mixed relaxation's name when the cap lowers some data row's localizing order d - ceil(deg / 2).
+std::string RelaxationName(const HwOuterSet& set, int order, int block_order_cap) {
+  bool capped = false;
+  if (block_order_cap >= 0 && set.num_orthants() > 0)
+    for (const auto& g : set.data_constraints(0)) capped = capped || order - (g.g.degree() + 1) / 2 > block_order_cap;
+  if (!capped) return fmt::format("order {}", order);
   return fmt::format("order {} with data-row blocks of localizing order <= {} (mixed: between the orders)", order,
                      block_order_cap);
 }
@@ -106,6 +110,20 @@ std::vector<int> WantedParameters(const BoundsOptions& options, const HwOuterSet
 bool Fail(std::string* error, std::string message) {
   if (error) *error = std::move(message);
   return false;
+}
+
+// Each interval's range over the feasible points (ParameterInterval::witnessed_lower/upper).
+void AttachWitnessedRanges(const HwOuterSet& set, const std::vector<FeasiblePoint>& points,
+                           std::vector<ParameterInterval>& intervals) {
+  const auto& names = set.layout().names;
+  for (auto& iv : intervals) {
+    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
+    for (const auto& p : points) {
+      if (k >= p.point.size()) continue;
+      iv.witnessed_lower = std::min(iv.witnessed_lower.value_or(p.point[k]), p.point[k]);
+      iv.witnessed_upper = std::max(iv.witnessed_upper.value_or(p.point[k]), p.point[k]);
+    }
+  }
 }
 
 }  // namespace
@@ -203,9 +221,21 @@ nlohmann::json BoundsSummary::to_json() const {
     return nlohmann::json{{"value", none ? nlohmann::json(nullptr) : nlohmann::json(e.value)}, {"status", e.status}, {"note", e.note}, {"orthant", e.orthant},
                           {"tight", e.tight}, {"verification", e.verification}, {"correction", e.correction}};
   };
+  auto witnessed = [](const ParameterInterval& iv) {
+    if (!iv.witnessed_lower || !iv.witnessed_upper) return nlohmann::json(nullptr);
+    return nlohmann::json{{"lower", *iv.witnessed_lower}, {"upper", *iv.witnessed_upper}};
+  };
   for (const auto& iv : intervals)
     j["intervals"].push_back({{"parameter", iv.name}, {"lower", ep(iv.lower)}, {"upper", ep(iv.upper)},
-                              {"half_width", none ? nlohmann::json(nullptr) : nlohmann::json(iv.half_width())}});
+                              {"half_width", none ? nlohmann::json(nullptr) : nlohmann::json(iv.half_width())},
+                              {"witnessed", witnessed(iv)}});
+  j["feasible_points"] = nlohmann::json::array();
+  for (const auto& p : feasible_points) {
+    nlohmann::json point;
+    for (std::size_t i = 0; i < p.point.size() && i < parameter_names.size(); ++i) point[parameter_names[i]] = p.point[i];
+    j["feasible_points"].push_back(
+        {{"orthant", p.orthant}, {"point", point}, {"certified_min_slack", p.certified_min_slack}});
+  }
   for (const auto& o : orthants)
     j["orthants"].push_back({{"index", o.index}, {"signs", o.signs}, {"status", o.status},
                              {"certificate", o.certificate ? o.certificate->to_json() : nlohmann::json(nullptr)}});
@@ -314,13 +344,15 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   BoundsSummary summary;
   summary.intervals = agg.intervals;
   summary.bound_sources = agg.sources;
+  summary.feasible_points = edges.feasible_points;
+  AttachWitnessedRanges(set, summary.feasible_points, summary.intervals);
   summary.clipped_to_box = agg.clipped_to_box;
   summary.contraction_passes_run = cheap.contraction_passes_run;
   summary.order = options.order;
   summary.horizon = set.horizon();
   summary.solver = SolverForOrder(options.solver, options.order, options.generation.block_order_cap);
   summary.solver_option = options.solver;
-  summary.relaxation = RelaxationName(options.order, options.generation.block_order_cap);
+  summary.relaxation = RelaxationName(set, options.order, options.generation.block_order_cap);
   summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
   summary.box = set.box();
   summary.parameter_names = set.layout().names;

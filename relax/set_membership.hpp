@@ -83,6 +83,10 @@ struct Endpoint {
 struct ParameterInterval {
   std::string name;
   Endpoint lower, upper;
+  // The range of the parameter over the certified feasible points the engine found (BoundsSummary::
+  // feasible_points): the exact interval of D^ss(n) contains it, so [lower, witnessed_lower] and
+  // [witnessed_upper, upper] bound what the relaxation may still overestimate. Absent without such points.
+  std::optional<double> witnessed_lower, witnessed_upper;
   double half_width() const { return 0.5 * (upper.value - lower.value); }
 };
 
@@ -145,6 +149,8 @@ struct BoundsSummary {
   std::vector<nlohmann::json> row_reduction;
   // Where the orthant bounds entering the endpoints came from (see relax/aggregate.hpp).
   std::map<std::string, int> bound_sources;
+  // Certified points of D^ss(n) found by the edge-witness stage, the most extreme ones per parameter.
+  std::vector<FeasiblePoint> feasible_points;
   bool clipped_to_box = false;
   nlohmann::json to_json() const;
   bool all_guaranteed() const;

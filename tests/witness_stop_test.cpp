@@ -71,17 +71,43 @@ TEST(WitnessStop, OnlyCertifiedPointsInsideTheirOrthantsBoxGiveValues) {
   w.box = set.box();
   auto far = truth;
   far[4] = 9.0;  // a1 far from every point that explains the data: not certified
-  const auto extremes = WitnessedExtremes(set, objectives, {w}, {{{l, 0}, truth}, {{l, 1}, far}});
+  const auto certified = CertifiedFeasiblePoints(set, {w}, {{{l, 0}, truth}, {{l, 1}, far}});
+  ASSERT_EQ(certified.size(), 1u);
+  EXPECT_EQ(certified[0].orthant, l);
+  EXPECT_GE(certified[0].certified_min_slack, 0.0);
+  const auto extremes = WitnessedExtremes(objectives, certified);
   ASSERT_EQ(extremes.size(), objectives.size());
   for (std::size_t j = 0; j < objectives.size(); ++j) EXPECT_EQ(extremes.at(j), truth[objectives[j].param]);
   // A box that leaves the truth out (a contracted box of the orthant): its point says nothing there.
   w.box[4] = {0.0, 1.0};
-  EXPECT_TRUE(WitnessedExtremes(set, objectives, {w}, {{{l, 0}, truth}}).empty());
+  EXPECT_TRUE(CertifiedFeasiblePoints(set, {w}, {{{l, 0}, truth}}).empty());
   // A point claimed for another orthant is checked against that orthant's inequalities.
   OrthantWork other = w;
   other.index = l ^ 1;
   other.box = set.box();
-  EXPECT_TRUE(WitnessedExtremes(set, objectives, {other}, {{{l ^ 1, 0}, truth}}).empty());
+  EXPECT_TRUE(CertifiedFeasiblePoints(set, {other}, {{{l ^ 1, 0}, truth}}).empty());
+}
+
+TEST(WitnessStop, TheReportedFeasiblePointsAreTheMostExtremeOnesEachOnce) {
+  const int dim = 3;
+  auto point = [&](double x0, double x1, double x2) { return FeasiblePoint{0, {x0, x1, x2}, 0.0}; };
+  const std::vector<FeasiblePoint> points = {point(0, 0, 0), point(-2, 5, 1), point(3, 5, -1), point(1, -4, 1)};
+  std::vector<Objective> objectives;
+  for (int k = 0; k < dim; ++k) objectives.push_back({k, -1}), objectives.push_back({k, +1});
+  const auto extremes = WitnessedExtremes(objectives, points);
+  EXPECT_EQ(extremes.at(0), -2);
+  EXPECT_EQ(extremes.at(1), 3);
+  EXPECT_EQ(extremes.at(2), -4);
+  EXPECT_EQ(extremes.at(3), 5);
+  EXPECT_EQ(extremes.at(4), -1);
+  EXPECT_EQ(extremes.at(5), 1);
+  // x1's max is attained twice (points 1 and 2): the first is reported; x2's max by points 1 and 3: point 1.
+  const auto extreme = ExtremeFeasiblePoints(objectives, points);
+  ASSERT_EQ(extreme.size(), 3u);
+  EXPECT_EQ(extreme[0].point, points[1].point);
+  EXPECT_EQ(extreme[1].point, points[2].point);
+  EXPECT_EQ(extreme[2].point, points[3].point);
+  EXPECT_TRUE(ExtremeFeasiblePoints(objectives, {}).empty());
 }
 
 TEST(WitnessStop, AnOrthantWhoseSignBoundIsBeyondAWitnessedValueIsSettledWithoutAnSdp) {

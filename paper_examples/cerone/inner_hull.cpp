@@ -107,7 +107,8 @@ InnerInterval HullOf(const relax::HwOuterSet& set, const WitnessPool& pool, int 
 }  // namespace
 
 InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<double>& truth,
-                           const std::vector<int>& params, const InnerHullOptions& options) {
+                           const std::vector<int>& params, const InnerHullOptions& options,
+                           const std::vector<std::vector<double>>& given) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   const auto t0 = std::chrono::steady_clock::now();
@@ -117,6 +118,9 @@ InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<doubl
   const auto objectives = Objectives(wanted);
   WitnessPool pool(set, options);
   pool.Add(truth, -1);
+  const std::size_t before_given = pool.witnesses().size();
+  for (const auto& p : given) pool.Add(p, -1);
+  const int given_witnesses = static_cast<int>(pool.witnesses().size() - before_given);
   // 1. From the truth, in its orthant.
   const int truth_orthant = set.orthant_of(truth);
   for (std::size_t j = 0; j < objectives.size(); ++j)
@@ -140,6 +144,7 @@ InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<doubl
   InnerHull hull;
   for (int k : wanted) hull.intervals.push_back(HullOf(set, pool, k));
   hull.witnesses = static_cast<int>(pool.witnesses().size());
+  hull.given_witnesses = given_witnesses;
   hull.local_solves = pool.solves();
   hull.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return hull;

@@ -7,7 +7,8 @@
 // optimisation (relax::LocalExtreme) of each wanted parameter in both directions, started from
 //   1. the truth (in the truth's orthant),
 //   2. deterministic pseudo-random points in the hull found so far, widened by `spread` (in each start's orthant),
-//   3. the witness most extreme in the objective's parameter, when another objective's search found it;
+//   3. the witness most extreme in the objective's parameter, when another objective's search found it or it
+//      was given (e.g. the bound engine's certified feasible points, relax::BoundsSummary::feasible_points);
 // a local search from one start misses far parts of a thin set, so the hull is only ever a lower bound of the
 // exact interval.
 #include <cstdint>
@@ -45,7 +46,8 @@ struct InnerInterval {
 
 struct InnerHull {
   std::vector<InnerInterval> intervals;  // the wanted parameters, in layout order
-  int witnesses = 0;                     // certified points found (truth included)
+  int witnesses = 0;                     // certified points found (truth and given points included)
+  int given_witnesses = 0;               // given points that certified
   int local_solves = 0;
   double seconds = 0.0;
 };
@@ -54,8 +56,10 @@ struct InnerHull {
 // certified feasible point of its orthant.
 Witness CertifyWitness(const relax::HwOuterSet& set, std::vector<double> point);
 
-// The inner hull of the parameters `params` (layout indices; empty = all) from `truth` (need not be feasible).
+// The inner hull of the parameters `params` (layout indices; empty = all) from `truth` (need not be feasible)
+// and the points `given` (each enters when it certifies, and is a restart point like any witness).
 InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<double>& truth,
-                           const std::vector<int>& params, const InnerHullOptions& options = {});
+                           const std::vector<int>& params, const InnerHullOptions& options = {},
+                           const std::vector<std::vector<double>>& given = {});
 
 }  // namespace hw::cerone

@@ -55,11 +55,17 @@ TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint
   c.samples = options.samples;
   c.names = set.layout().names;
   c.truth = CeroneExample::TrueParameters();
-  c.inner = ComputeInnerHull(set, c.truth, ParameterIndices(set, options.params), options.inner);
-  log(fmt::format("{}: inner hull from {} witnesses, {} local solves, {:.1f} s", c.label(), c.inner.witnesses,
-                  c.inner.local_solves, c.inner.seconds));
+  // The outer intervals first: their runs' certified feasible points seed the inner hull (the engine searches
+  // every live orthant, the hull's own starts only the truth's and those around it).
   for (int order : options.orders)
     if (options.outer_wanted(order, horizon, snr_db)) c.outer[order] = RunOuter(options, set, c, order, log);
+  std::vector<std::vector<double>> engine_points;
+  for (const auto& [order, run] : c.outer)
+    for (const auto& p : run.feasible_points) engine_points.push_back(p.point);
+  c.inner = ComputeInnerHull(set, c.truth, ParameterIndices(set, options.params), options.inner, engine_points);
+  log(fmt::format("{}: inner hull from {} witnesses ({} of {} given by the engine), {} local solves, {:.1f} s",
+                  c.label(), c.inner.witnesses, c.inner.given_witnesses, engine_points.size(), c.inner.local_solves,
+                  c.inner.seconds));
   return c;
 }
 
