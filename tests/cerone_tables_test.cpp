@@ -169,6 +169,33 @@ TEST(CeroneTables, InnerHullsNarrowWithLessNoise) {
   EXPECT_LT(MedianLogRatio(at60), MedianLogRatio(at31));
 }
 
+// The engine's feasible points enter the inner hull when they certify (the harness passes them as `given`):
+// a point from a full local search widens a hull whose own searches stop after one iteration; a point that
+// explains nothing is left out.
+TEST(CeroneTables, GivenPointsWidenTheInnerHullOnlyWhenTheyCertify) {
+  const auto ex = SimulateCeroneExample(1, 50, 31);
+  const auto set = ExampleSet(ex, 1, 10.0);
+  const auto truth = CeroneExample::TrueParameters();
+  const std::vector<int> a1 = ParameterIndices(set, {"a1"});
+  ASSERT_EQ(a1.size(), 1u);
+  InnerHullOptions short_searches;
+  short_searches.random_starts = 0;
+  short_searches.restart_rounds = 0;
+  short_searches.local.max_iterations = 1;
+  const auto far = relax::LocalExtreme(set, set.orthant_of(truth), a1[0], -1, truth);
+  ASSERT_TRUE(far.found);
+  const InnerHull own = ComputeInnerHull(set, truth, a1, short_searches);
+  ASSERT_TRUE(own.intervals[0].found);
+  ASSERT_LT(far.value, own.intervals[0].lower - 1e-3) << "the full search must reach beyond the short ones";
+  auto nonsense = truth;
+  nonsense[a1[0]] = 9.0;
+  const InnerHull seeded = ComputeInnerHull(set, truth, a1, short_searches, {far.point, nonsense});
+  EXPECT_EQ(seeded.given_witnesses, 1);
+  EXPECT_EQ(seeded.intervals[0].lower, far.value);
+  EXPECT_EQ(seeded.intervals[0].upper, own.intervals[0].upper);
+  EXPECT_GE(relax::CertifiedMinSlack(set, seeded.intervals[0].lower_witness.orthant, seeded.intervals[0].lower_witness.point), 0.0);
+}
+
 int Parse(const std::vector<std::string>& args, TablesCommand* command = nullptr) {
   TablesCommand local;
   std::string message;

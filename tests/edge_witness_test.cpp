@@ -50,6 +50,26 @@ TEST(EdgeWitness, SettledEndpointsEqualTheRelaxationsAndContainTheTruth) {
     const double edge = lower ? set.box()[k].first : set.box()[k].second;
     if (x.value == edge) EXPECT_NEAR(y.value, edge, 1e-4) << name << (lower ? " lower" : " upper");
   });
+  // The reported feasible points certify in their orthants, and each interval's witnessed range lies inside it
+  // and is the range over those points; without the stage there are none.
+  ASSERT_FALSE(with.feasible_points.empty());
+  EXPECT_TRUE(without.feasible_points.empty());
+  for (const auto& p : with.feasible_points) EXPECT_GE(CertifiedMinSlack(set, p.orthant, p.point), 0.0);
+  const auto& names = set.layout().names;
+  for (const auto& iv : with.intervals) {
+    ASSERT_TRUE(iv.witnessed_lower && iv.witnessed_upper) << iv.name;
+    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& p : with.feasible_points) lo = std::min(lo, p.point[k]), hi = std::max(hi, p.point[k]);
+    EXPECT_EQ(*iv.witnessed_lower, lo) << iv.name;
+    EXPECT_EQ(*iv.witnessed_upper, hi) << iv.name;
+    EXPECT_LE(iv.lower.value, lo) << iv.name;
+    EXPECT_GE(iv.upper.value, hi) << iv.name;
+    EXPECT_FALSE(without.intervals[&iv - with.intervals.data()].witnessed_lower) << iv.name;
+  }
+  const auto json = with.to_json();
+  EXPECT_EQ(json.at("feasible_points").size(), with.feasible_points.size());
+  EXPECT_EQ(json.at("intervals")[0].at("witnessed").at("lower").get<double>(), *with.intervals[0].witnessed_lower);
 }
 
 TEST(EdgeWitness, OptionsAreChecked) {
