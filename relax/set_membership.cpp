@@ -45,10 +45,10 @@ BoundsOptions EngineOptions(const BoundsOptions& options) {
   return opts;
 }
 
-// The backend of each relaxation order up to the run's order (index 0: order 1).
+// The backend of every relaxation order (index 0: order 1), whatever the run's order.
 std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
   std::vector<std::string> backends;
-  for (int d = 1; d <= options.order; ++d)
+  for (int d = 1; d <= kMaxOrder; ++d)
     backends.push_back(SolverForOrder(options.solver, d, options.generation.block_order_cap));
   return backends;
 }
@@ -64,9 +64,12 @@ std::string RelaxationName(const HwOuterSet& set, int order, int block_order_cap
                      block_order_cap);
 }
 
-// Everything that changes the numbers, hashed into the run directory's name.
+// Everything that changes the numbers, hashed into the run directory's name. Not the run's order: a job's name
+// carries the relaxation order it solves, and the stages before it (screen, reduction, feasible points) do not
+// depend on it, so runs of several orders share one directory and an order-3 run reads back the order-2 jobs
+// of an order-2 run (its cheap pass).
 std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nlohmann::json* meta) {
-  *meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()}, {"order", options.order},
+  *meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()},
            {"cheap_pass", options.cheap_pass}, {"solver", options.solver}, {"backends", BackendsByOrder(options)},
            {"box", set.box()},
            {"violation_tolerance", options.generation.violation_tolerance},

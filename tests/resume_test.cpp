@@ -108,5 +108,29 @@ TEST_F(Resume, ResumeLineCountsFinishedJobsAgainstTheEarlierPlan) {
   }
 }
 
+// Runs of different orders share the run directory: an order-1 run reads back the LP screen of an order-2
+// run (the order is in each relaxation job's name, not in the problem's key) and gives the intervals of an
+// order-1 run in a fresh directory.
+TEST_F(Resume, RunsOfAnotherOrderReadBackTheJobsTheyShare) {
+  Recorded first, second, fresh;
+  options_.order = 2;
+  options_.threads = 2;
+  Run(&first);
+  options_.order = 1;
+  const BoundsSummary shared = Run(&second);
+  EXPECT_GT(shared.jobs_from_cache, 0);
+  ASSERT_TRUE(second.last.count("LP screen of orthants"));
+  EXPECT_EQ(second.last["LP screen of orthants"].total, 0) << "the screen is the order-2 run's";
+  EXPECT_GT(shared.sdp_jobs, 0) << "the order-1 relaxations are new";
+  options_.run_dir = (dir_ / "fresh").string();
+  const BoundsSummary alone = Run(&fresh);
+  EXPECT_EQ(alone.jobs_from_cache, 0);
+  ASSERT_EQ(shared.intervals.size(), alone.intervals.size());
+  for (std::size_t k = 0; k < shared.intervals.size(); ++k) {
+    EXPECT_EQ(shared.intervals[k].lower.value, alone.intervals[k].lower.value);
+    EXPECT_EQ(shared.intervals[k].upper.value, alone.intervals[k].upper.value);
+  }
+}
+
 }  // namespace
 }  // namespace hw::relax

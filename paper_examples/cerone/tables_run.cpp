@@ -24,14 +24,14 @@ std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vecto
 
 namespace {
 
-// The engine at one order, its run cache in a subdirectory of its own per run.
+// The engine at one order; the orders of one case share a run cache (the order-3 run reads back the order-2 jobs).
 relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuterSet& set, const TableCase& c,
                               int order, const Log& log) {
   relax::BoundsOptions bounds = options.bounds;
   bounds.order = order;
   bounds.parameters = options.params;
   if (!bounds.run_dir.empty())
-    bounds.run_dir += fmt::format("/N{}_seed{}_snr{:g}_n{}_d{}", c.samples, c.seed, c.snr_db, c.horizon, order);
+    bounds.run_dir += fmt::format("/N{}_seed{}_snr{:g}_n{}", c.samples, c.seed, c.snr_db, c.horizon);
   log(fmt::format("{}: outer intervals at order {} ...", c.label(), order));
   auto summary = relax::ComputeBounds(bounds, set, [&](const relax::BoundsProgress& p) {
     if (p.done == p.total && p.total > 0)
