@@ -63,11 +63,14 @@ std::string MarkdownRow(const TableCase& c, const InnerInterval& inner, const st
 }
 
 std::string CaseNotes(const TableCase& c) {
-  std::string notes = fmt::format("Inner hull: {} certified witnesses from {} local solves, {:.1f} s.", c.inner.witnesses,
+  std::string notes = fmt::format("Inner hull: {} certified witnesses ({} of them the engine's feasible points) from {} "
+                                  "local solves, {:.1f} s.", c.inner.witnesses, c.inner.given_witnesses,
                                   c.inner.local_solves, c.inner.seconds);
   for (const auto& [order, run] : c.outer)
-    notes += fmt::format(" Order {}: {}, solver {}, {} SDP solves, {:.1f} s{}.", order, run.relaxation, run.solver,
-                         run.sdp_solves, run.wall_seconds, run.all_guaranteed() ? "" : ", some endpoints conservative (*)");
+    notes += fmt::format(" Order {}: {}, solver {}, {} SDP solves, {:.1f} s{}{}.", order, run.relaxation, run.solver,
+                         run.sdp_solves, run.wall_seconds,
+                         run.jobs_from_cache > 0 ? fmt::format(" ({} jobs read from the run cache)", run.jobs_from_cache) : "",
+                         run.all_guaranteed() ? "" : ", some endpoints conservative (*)");
   return notes + "\n\n";
 }
 
@@ -116,8 +119,8 @@ std::string SettingsMarkdown(const TablesReport& r) {
   return fmt::format(
       "Command: `{}`\n\nN = {}, horizons {}, orders {} (outer intervals computed at orders {} and SNR {} dB), seeds "
       "{}, prior box ±{:g}, solver {}, data-row block order cap {}, verification {}. Inner hull: local optimisation "
-      "from the truth, {} pseudo-random starts per objective and {} restart round(s) from other witnesses; every "
-      "witness certified by evaluating every inequality of its orthant with a rounding allowance. Outer "
+      "from the truth, {} pseudo-random starts per objective and {} restart round(s) from other witnesses and from "
+      "the outer runs' certified feasible points (every live orthant's); every witness certified by evaluating every inequality of its orthant with a rounding allowance. Outer "
       "intervals marked * have a conservative endpoint; an inner hull marked (box) reaches the prior box.\n\n",
       r.command, o.samples, ListText(o.horizons), ListText(o.orders), ListText(o.outer_orders), ListText(o.outer_snrs),
       ListText(o.seeds), o.box, o.bounds.solver, o.bounds.generation.block_order_cap,
@@ -178,7 +181,8 @@ nlohmann::json CaseJson(const TableCase& c, double box) {
   for (const auto& [order, run] : c.outer) runs[std::to_string(order)] = run.to_json();
   return {{"n", c.horizon}, {"snr_db", c.snr_db}, {"realised_snr_db", c.realised_snr_db},
           {"noise_bound", c.noise_bound}, {"seed", c.seed}, {"samples", c.samples},
-          {"inner_hull", {{"witnesses", c.inner.witnesses}, {"local_solves", c.inner.local_solves},
+          {"inner_hull", {{"witnesses", c.inner.witnesses}, {"given_by_the_engine", c.inner.given_witnesses},
+                          {"local_solves", c.inner.local_solves},
                           {"seconds", c.inner.seconds}}},
           {"rows", rows}, {"outer_runs", runs}};
 }

@@ -33,9 +33,12 @@ relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuter
   if (!bounds.run_dir.empty())
     bounds.run_dir += fmt::format("/N{}_seed{}_snr{:g}_n{}", c.samples, c.seed, c.snr_db, c.horizon);
   log(fmt::format("{}: outer intervals at order {} ...", c.label(), order));
+  // A line per finished job (runs at order 3 take minutes per job), and the engine's messages ("resuming: ...").
   auto summary = relax::ComputeBounds(bounds, set, [&](const relax::BoundsProgress& p) {
-    if (p.done == p.total && p.total > 0)
-      log(fmt::format("  [{}] {} jobs, {:.0f} s", p.phase, p.total, p.elapsed_seconds));
+    if (p.total < 0) log("  " + p.phase);
+    else if (p.done > 0)
+      log(fmt::format("  [{}] {} of {} jobs, {:.0f} s{}", p.phase, p.done, p.total, p.elapsed_seconds,
+                      p.done < p.total ? fmt::format(", about {:.0f} s left", p.eta_seconds) : ""));
   });
   log(fmt::format("{}: order {} done in {:.1f} s", c.label(), order, summary.wall_seconds));
   return summary;
