@@ -2,7 +2,7 @@
 // generation, round by round: working-set size, SDP time and iterations, status, bound, and the time spent
 // outside the solver (building the LMI, checking omitted constraints). A timing harness, not a test.
 //   setmembership_job_bench [--samples N] [--horizon n] [--order d] [--param a1] [--max] [--solver sdpa]
-//                           [--add-per-round K] [--box LO,HI]
+//                           [--add-per-round K] [--box LO,HI] [--snr 31]
 #include <chrono>
 
 #include <CLI/CLI.hpp>
@@ -27,9 +27,10 @@ int main(int argc, char** argv) {
   int contract_rounds = 0, block_order_cap = -1, start_order = 0;
   double gap = 1e-7, feasibility = 1e-7;
   bool keep_prior_box = false;
-  double box = 10.0;
+  double box = 10.0, snr_db = 31.0;
   std::vector<double> box_list;
   app.add_option("--samples", samples);
+  app.add_option("--snr", snr_db, "SNR_w of the realisation in dB (sets the noise bound)");
   app.add_option("--horizon", horizon);
   app.add_option("--order", order);
   app.add_option("--param", param);
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
   app.add_option("--lp-contract", contract_rounds, "rounds of LP box contraction in the orthant before the job");
   CLI11_PARSE(app, argc, argv);
 
-  const auto ex = hw::SimulateCeroneExample(1, samples);
+  const auto ex = hw::SimulateCeroneExample(1, samples, snr_db);
   hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
   std::vector<std::pair<double, double>> boxes(8, {-box, box});
   if (box_list.size() == 16)
