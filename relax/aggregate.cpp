@@ -35,6 +35,18 @@ OrthantValue ValueOf(const AggregateOptions& options, const JobOutcome& r, const
     if (r.origin == "feasible point at the box edge" || r.origin == "box edge reached in another orthant" ||
         r.origin == "orthant sign constraint")
       v.source = r.origin;
+    // Both orders bound the same orthant, so the tighter one holds: an order-delta job that stopped short
+    // (unfinished solve, round limit) can end looser than the cheap order's bound.
+    const bool from_sdp = r.status == "solved" && (r.origin == "final round" || r.origin == "earlier round");
+    const bool cheap_tighter = dir < 0 ? c.bound > r.bound : c.bound < r.bound;
+    if (from_sdp && options.order > options.cheap_order && c.status == "solved" && cheap_tighter &&
+        (c.verification == r.verification || c.verification == "verified")) {
+      v.value = c.bound;
+      v.float_value = c.float_bound;
+      v.verification = c.verification;
+      v.tight = false;
+      v.source = "cheap order (tighter than an order-delta job that stopped short)";
+    }
     return v;
   }
   v.status = "conservative";

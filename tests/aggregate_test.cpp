@@ -86,5 +86,31 @@ TEST(Aggregate, AFailedJobFallsBackToTheBoxEdgeAndKeepsItsOrthant) {
   EXPECT_EQ(r.sources.at("box edge"), 1);
 }
 
+// An order-delta job that stopped short can end looser than the cheap order's bound of the same orthant; both
+// bound it, so the tighter one is the orthant's value (never looser than the cheap order: Property 3).
+TEST(Aggregate, ACheapBoundTighterThanAShortOrderDeltaBoundIsUsed) {
+  Fixture f;
+  PassOutcomes cheap;
+  cheap[{3, 0}] = Solved(0.30);
+  cheap[{7, 0}] = Solved(0.50);
+  cheap[{3, 1}] = Solved(1.90);
+  cheap[{7, 1}] = Solved(1.70);
+  PassOutcomes full;
+  full[{3, 0}] = Solved(0.25);  // stopped short: looser than its cheap bound 0.30
+  full[{3, 0}].tight = false;
+  full[{3, 0}].unfinished = true;
+  full[{7, 0}] = Solved(0.55);
+  full[{3, 1}] = Solved(1.85);
+  full[{7, 1}] = Solved(1.75);  // looser than 1.70 as well, but not the extreme orthant
+  const AggregateResult r =
+      AggregateIntervals(AggregateOptions{true, 3, 2}, f.set, f.objectives, {4}, cheap, full, f.orthants);
+  EXPECT_EQ(r.intervals[0].lower.value, 0.30);
+  EXPECT_EQ(r.intervals[0].lower.orthant, 3);
+  EXPECT_EQ(r.intervals[0].lower.status, "guaranteed");
+  EXPECT_FALSE(r.intervals[0].lower.tight);
+  EXPECT_EQ(r.intervals[0].upper.value, 1.85);
+  EXPECT_EQ(r.sources.at("cheap order (tighter than an order-delta job that stopped short)"), 2);
+}
+
 }  // namespace
 }  // namespace hw::relax
