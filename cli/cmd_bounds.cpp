@@ -66,7 +66,7 @@ struct BoundsCliOptions {
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
-  bool proper = false, no_cheap = false, no_edge_witnesses = false, quiet = false, verify = false, no_verify = false;
+  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_full_pass_contraction = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
   int row_block_order = -1;
 };
@@ -133,6 +133,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.run_dir = o.run_dir;
   options.cheap_pass = !o.no_cheap;
   options.edge_witness.enabled = !o.no_edge_witnesses;
+  options.contract_before_full_pass = !o.no_full_pass_contraction;
   options.contraction_passes = o.contraction_passes;
   options.generation.block_order_cap = o.row_block_order;
   options.parameters = o.params;
@@ -326,6 +327,9 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--row-block-order", o->row_block_order,
                   "localizing order of the data rows' blocks at most (-1: full order; 1 at order 3: 9x9 blocks, a "
                   "mixed relaxation between orders 2 and 3, valid and cheaper)");
+  cmd->add_flag("--no-full-pass-contraction", o->no_full_pass_contraction,
+                "run the order-delta jobs in the prior box, not in each orthant's box contracted to its cheap-order "
+                "bounds");
   cmd->add_option("--contract-passes", o->contraction_passes,
                   "cheap passes repeated in each orthant's contracted box, 0..10 (0 = no box contraction)");
   auto* verify = cmd->add_flag("--verify", o->verify,

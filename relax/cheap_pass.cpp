@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "relax/box_contraction.hpp"
 #include "relax/edge_witness.hpp"
 #include "relax/row_reduction.hpp"
 
@@ -65,49 +66,6 @@ PassOutcomes RunOnePass(EngineContext& ctx, const std::vector<Objective>& object
   return out;
 }
 
-// Contracts each orthant's box to its verified cheap bounds; returns the largest relative shrink. Bounds that
-// cross prove the orthant empty.
-double ContractBoxes(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& pass,
-                     std::vector<OrthantWork>& orthants, int order) {
-  const bool verify_on = ctx.options.generation.verify.enabled;
-  const int n = ctx.set.num_vars();
-  double shrink = 0.0;
-  for (auto& o : orthants) {
-    if (o.empty()) continue;
-    Box next = o.box;
-    bool crossed = false;
-    for (int k = 0; k < n && !crossed; ++k) {
-      const double width = next[k].second - next[k].first;
-      for (std::size_t j = 0; j < objectives.size(); ++j) {
-        if (objectives[j].param != k) continue;
-        const auto& r = pass.at({o.index, static_cast<int>(j)});
-        if (r.status != "solved" || (verify_on && r.verification != "verified")) continue;
-        if (objectives[j].dir < 0) next[k].first = std::max(next[k].first, r.bound);
-        else next[k].second = std::min(next[k].second, r.bound);
-      }
-      if (next[k].first > next[k].second) {
-        crossed = true;  // rigorous bounds that cross: no point of the orthant in the box
-        break;
-      }
-      // A box side of (near) zero width would break the scaling: keep a sliver (widening stays valid).
-      const auto prior = ctx.set.box()[k];
-      const double min_width = 1e-6 * (prior.second - prior.first);
-      if (next[k].second - next[k].first < min_width) {
-        const double mid = 0.5 * (next[k].first + next[k].second);
-        next[k] = {std::max(prior.first, mid - min_width), std::min(prior.second, mid + min_width)};
-      }
-      shrink = std::max(shrink, 1.0 - (next[k].second - next[k].first) / width);
-    }
-    if (crossed) {
-      // Only verified bounds enter the contraction when verification is on (above).
-      o.ProveEmpty({"crossed bounds", order, true, verify_on});
-      continue;
-    }
-    o.box = next;
-  }
-  return shrink;
-}
-
 }  // namespace
 
 std::vector<int> PositionsOfRows(const OrthantWork& orthant, const std::vector<int>& data_rows) {
@@ -150,7 +108,7 @@ CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx
       std::sort(rows.begin(), rows.end());
       rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
     }
-    const double shrink = ContractBoxes(ctx, objectives, result.outcomes, orthants, options.order);
+    const double shrink = ContractOrthantBoxes(ctx, objectives, result.outcomes, orthants, options.order);
     result.contraction_passes_run = pass + 1;
     ReduceOrthantRows(ctx, orthants);  // the rows in the new boxes
     // Little movement: skip the remaining contraction passes and run the last (full) cheap pass.

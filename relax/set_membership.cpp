@@ -11,6 +11,7 @@
 #include "relax/aggregate.hpp"
 #include "relax/bound_jobs.hpp"
 #include "relax/cheap_pass.hpp"
+#include "relax/box_contraction.hpp"
 #include "relax/edge_witness.hpp"
 #include "relax/full_pass.hpp"
 #include "relax/orthant_screen.hpp"
@@ -67,7 +68,8 @@ std::string RelaxationName(const HwOuterSet& set, int order, int block_order_cap
 // Everything that changes the numbers, hashed into the run directory's name. Not the run's order: a job's name
 // carries the relaxation order it solves, and the stages before it (screen, reduction, feasible points) do not
 // depend on it, so runs of several orders share one directory and an order-3 run reads back the order-2 jobs
-// of an order-2 run (its cheap pass).
+// of an order-2 run (its cheap pass). Nor contract_before_full_pass: a job in a contracted box has the box's hash
+// in its name.
 std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nlohmann::json* meta) {
   *meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()},
            {"cheap_pass", options.cheap_pass}, {"solver", options.solver}, {"backends", BackendsByOrder(options)},
@@ -334,15 +336,18 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   CheapPassOptions cheap_options{cheap_order, options.contraction_passes, options.contraction_min_shrink,
                                  options.contraction_max_rounds};
   const CheapPassResult cheap = RunCheapPass(cheap_options, ctx, objectives, edges.settled, edges.witnessed, orthants);
-  // 5. Full pass.
-  PassOutcomes full = cheap.outcomes;
+  // 5. Full pass, in boxes contracted to the cheap bounds.
+  PassOutcomes cheap_outcomes = cheap.outcomes;
+  if (options.order > cheap_order && options.contract_before_full_pass)
+    cheap_outcomes = ContractBeforeFullPass(ctx, objectives, cheap.outcomes, orthants, cheap_order);
+  PassOutcomes full = cheap_outcomes;
   if (options.order > cheap_order)
-    full = RunFullPass(FullPassOptions{options.order, cheap_order}, ctx, objectives, wanted_objectives, cheap.outcomes,
+    full = RunFullPass(FullPassOptions{options.order, cheap_order}, ctx, objectives, wanted_objectives, cheap_outcomes,
                        edges.settled, edges.witnessed, orthants);
   // 6. Aggregate.
   const AggregateResult agg = AggregateIntervals(
       AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,
-      cheap.outcomes, full, orthants);
+      cheap_outcomes, full, orthants);
 
   BoundsSummary summary;
   summary.intervals = agg.intervals;

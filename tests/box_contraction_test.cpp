@@ -212,5 +212,43 @@ TEST(BoxContraction, KeepsTheTruthAndNeverWidensAnInterval) {
                plain.intervals[&iv - &contracted.intervals[0]].upper.value, iv.lower.value, iv.upper.value);
 }
 
+// Before the order-3 pass every orthant's box shrinks to its order-2 bounds: the intervals keep the truth, are no
+// wider than at order 2 or than order 3 in the prior box, and the truth's orthant box still holds the truth.
+TEST(BoxContraction, TheFullPassRunsInTheBoxesOfTheCheapBounds) {
+  BoundsOptions options;
+  options.order = 3;
+  options.solver = "csdp";
+  options.threads = 2;
+  options.retry_with_other_solver = false;
+  const HwOuterSet set = SmallSet(40);
+  const auto contracted = ComputeBounds(options, set);
+  options.contract_before_full_pass = false;
+  const auto prior_box = ComputeBounds(options, set);
+  options.order = 2;
+  const auto order2 = ComputeBounds(options, set);
+  EXPECT_TRUE(prior_box.orthant_boxes.empty());
+  ASSERT_FALSE(contracted.orthant_boxes.empty());
+  const int truth_orthant = set.orthant_of(kTruth);
+  for (const auto& [l, box] : contracted.orthant_boxes)
+    if (l == truth_orthant)
+      for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_LE(box[k].first, kTruth[k]);
+        EXPECT_GE(box[k].second, kTruth[k]);
+        EXPECT_LT(box[k].second - box[k].first, 5.0) << "parameter " << k << ": the cheap bounds must contract";
+      }
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& c = contracted.intervals[k];
+    SCOPED_TRACE(c.name);
+    EXPECT_EQ(c.lower.status, "guaranteed");
+    EXPECT_EQ(c.upper.status, "guaranteed");
+    EXPECT_LE(c.lower.value, kTruth[k]);
+    EXPECT_GE(c.upper.value, kTruth[k]);
+    for (const auto* other : {&prior_box.intervals[k], &order2.intervals[k]}) {
+      EXPECT_GE(c.lower.value, other->lower.value - 1e-6);
+      EXPECT_LE(c.upper.value, other->upper.value + 1e-6);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hw::relax
