@@ -136,7 +136,8 @@ void DefineBounds(py::module_& m) {
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
          std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
-         bool edge_witnesses, bool lp_screen, bool retry_with_other_solver, int contraction_passes, double contraction_min_shrink,
+         bool edge_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
+         int contraction_passes, double contraction_min_shrink,
          int contraction_max_rounds, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
          py::object progress, std::string source) {
         BoundsArgs a;
@@ -159,6 +160,7 @@ void DefineBounds(py::module_& m) {
         op.edge_witness.enabled = edge_witnesses;
         op.lp_screen = lp_screen;
         op.retry_with_other_solver = retry_with_other_solver;
+        op.contract_before_full_pass = full_pass_contraction;
         op.contraction_passes = contraction_passes;
         op.contraction_min_shrink = contraction_min_shrink;
         op.contraction_max_rounds = contraction_max_rounds;
@@ -185,6 +187,7 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,
       py::arg("lp_screen") = o.lp_screen,
       py::arg("retry_with_other_solver") = o.retry_with_other_solver,
+      py::arg("full_pass_contraction") = o.contract_before_full_pass,
       py::arg("contraction_passes") = o.contraction_passes,
       py::arg("contraction_min_shrink") = o.contraction_min_shrink,
       py::arg("contraction_max_rounds") = o.contraction_max_rounds, py::arg("max_rounds") = g.max_rounds,
