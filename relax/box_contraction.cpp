@@ -1,13 +1,14 @@
 #include "relax/box_contraction.hpp"
 
 #include <algorithm>
+#include <map>
 
 #include "relax/row_reduction.hpp"
 
 namespace hw::relax {
 
 double ContractOrthantBoxes(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& pass,
-                     std::vector<OrthantWork>& orthants, int order) {
+                            std::vector<OrthantWork>& orthants, int order) {
   const bool verify_on = ctx.options.generation.verify.enabled;
   const int n = ctx.set.num_vars();
   double shrink = 0.0;
@@ -49,11 +50,11 @@ double ContractOrthantBoxes(EngineContext& ctx, const std::vector<Objective>& ob
 
 PassOutcomes ContractBeforeFullPass(EngineContext& ctx, const std::vector<Objective>& objectives,
                                     const PassOutcomes& cheap, std::vector<OrthantWork>& orthants, int cheap_order) {
+  std::map<int, std::size_t> position;  // orthant index -> position in `orthants`
+  for (std::size_t i = 0; i < orthants.size(); ++i) position[orthants[i].index] = i;
   // The cheap working sets as data-row indices, before the rows change.
   std::map<std::pair<int, int>, std::vector<int>> working_rows;
-  for (const auto& [key, r] : cheap)
-    for (const auto& w : orthants)
-      if (w.index == key.first) working_rows[key] = RowsOfWorkingSet(w, r.working_set);
+  for (const auto& [key, r] : cheap) working_rows[key] = RowsOfWorkingSet(orthants[position.at(key.first)], r.working_set);
   std::vector<Box> before;
   for (const auto& w : orthants) before.push_back(w.box);
   ContractOrthantBoxes(ctx, objectives, cheap, orthants, cheap_order);
@@ -61,13 +62,10 @@ PassOutcomes ContractBeforeFullPass(EngineContext& ctx, const std::vector<Object
   for (std::size_t i = 0; i < orthants.size(); ++i)
     if (!orthants[i].empty() && orthants[i].box != before[i]) moved.push_back(orthants[i]);
   ReduceOrthantRows(ctx, moved);
-  for (const auto& m : moved)
-    for (auto& w : orthants)
-      if (w.index == m.index) w = m;
+  for (const auto& m : moved) orthants[position.at(m.index)] = m;
   PassOutcomes renumbered = cheap;
   for (auto& [key, r] : renumbered)
-    for (const auto& w : orthants)
-      if (w.index == key.first && !w.empty()) r.working_set = PositionsOfRows(w, working_rows[key]);
+    if (const auto& w = orthants[position.at(key.first)]; !w.empty()) r.working_set = PositionsOfRows(w, working_rows[key]);
   return renumbered;
 }
 

@@ -54,7 +54,6 @@ std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
   return backends;
 }
 
-// "order 3", or "order 3 with data-row blocks of localizing order <= 1" for a capped (mixed) relaxation.
 // "order d", or the mixed relaxation's name when the cap lowers some data row's localizing order d - ceil(deg / 2).
 std::string RelaxationName(const HwOuterSet& set, int order, int block_order_cap) {
   bool capped = false;
