@@ -76,6 +76,59 @@ TEST(CeroneTables, SmallRunHoldsEveryPropertyAndWritesTheFields) {
   EXPECT_EQ(plots.front().stem, "intervals_snr31_seed1");
 }
 
+// n = 1 then n = 2 of one realisation: the longer horizon's outer runs start in the box of the shorter one's
+// outer intervals, and that box holds every certified point of D^ss(2) the inner hull finds (the premise:
+// D^ss(2) lies inside D^ss(1)). Outer runs at n = 1 only (order 1, milliseconds per job).
+TEST(CeroneTables, LongerHorizonStartsInTheShorterOnesOuterBox) {
+  TablesOptions options = SmallOptions();
+  options.horizons = {2, 1};  // run in ascending order whatever the list's order
+  options.orders = {1, 2};
+  options.outer_orders = {1};
+  const auto cases = RunTables(options, kQuiet);
+  ASSERT_EQ(cases.size(), 2u);
+  ASSERT_EQ(cases[0].horizon, 1);
+  ASSERT_EQ(cases[1].horizon, 2);
+  ASSERT_TRUE(cases[0].outer.count(1));
+  EXPECT_EQ(cases[0].box_from_horizon, 0);
+  EXPECT_EQ(cases[1].box_from_horizon, 1);
+  const auto box = OuterIntervalBox(cases[0]);
+  ASSERT_EQ(cases[1].outer_box, box);
+  int shrunk = 0;
+  for (std::size_t k = 0; k < box.size(); ++k) shrunk += box[k].second - box[k].first < 2 * options.box - 1e-6;
+  EXPECT_GE(shrunk, 1);  // a1 at least (at N = 50 the n = 1 interval of b1 may reach the prior box)
+  for (const auto& inner : cases[1].inner.intervals) {
+    ASSERT_TRUE(inner.found) << inner.name;
+    const auto k = std::find(cases[1].names.begin(), cases[1].names.end(), inner.name) - cases[1].names.begin();
+    EXPECT_LE(box[k].first, inner.lower) << inner.name;
+    EXPECT_GE(box[k].second, inner.upper) << inner.name;
+  }
+  options.nest_horizons = false;
+  const auto separate = RunTables(options, kQuiet);
+  EXPECT_EQ(separate[1].box_from_horizon, 0);
+  const std::vector<std::pair<double, double>> prior(8, {-options.box, options.box});
+  EXPECT_EQ(separate[1].outer_box, prior);
+}
+
+TEST(CeroneTables, OuterIntervalBoxIntersectsEveryRunWithTheStartingBox) {
+  TableCase c;
+  c.names = {"a1", "b1"};
+  c.outer_box = {{-10, 10}, {-1, 1}};
+  relax::ParameterInterval a1, b1, a1_tighter;
+  a1.name = a1_tighter.name = "a1", b1.name = "b1";
+  a1.lower.value = -2, a1.upper.value = 3;
+  a1_tighter.lower.value = -1, a1_tighter.upper.value = 5;
+  b1.lower.value = -4, b1.upper.value = 0.5;
+  c.outer[2].intervals = {a1, b1};
+  c.outer[3].intervals = {a1_tighter};
+  const auto box = OuterIntervalBox(c);
+  EXPECT_NEAR(box[0].first, -1, 1e-8);
+  EXPECT_NEAR(box[0].second, 3, 1e-8);
+  EXPECT_LT(box[0].first, -1);  // widened outward, never inward
+  EXPECT_GT(box[0].second, 3);
+  EXPECT_NEAR(box[1].first, -1, 1e-8);
+  EXPECT_NEAR(box[1].second, 0.5, 1e-8);
+}
+
 // A synthetic interval for the checker.
 relax::ParameterInterval Iv(const std::string& name, double lo, double hi) {
   relax::ParameterInterval iv;

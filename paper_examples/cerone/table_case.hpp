@@ -22,6 +22,9 @@ struct TableCase {
   std::vector<double> truth;       // in layout order
   InnerHull inner;                 // the wanted parameters
   std::map<int, relax::BoundsSummary> outer;  // relaxation order -> the engine's run (wanted parameters)
+  // The box the outer runs started in: the prior box, or the outer intervals of horizon `box_from_horizon`.
+  std::vector<std::pair<double, double>> outer_box;
+  int box_from_horizon = 0;  // 0: the prior box
   // "n=2, 31 dB, seed 1": for messages.
   std::string label() const;
 };

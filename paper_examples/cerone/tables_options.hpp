@@ -22,6 +22,11 @@ struct TablesOptions {
   int samples = 1000;
   std::vector<std::string> params;  // parameters in the tables (names); empty = all eight
   double box = 10.0;                // prior box [-box, box]^8, as in the paper
+  // D^ss(n) lies inside D^ss(n-1) (its rows are a superset; Property 4), so the outer intervals of a shorter
+  // horizon of the same realisation bound the longer one's set too: the longer horizon's engine runs start in
+  // that box instead of the prior box (better conditioned LMIs, fewer live orthants). Property 4 then holds by
+  // construction for the outer intervals; it stays a real check with nest_horizons off.
+  bool nest_horizons = true;
   double tolerance = 1e-6;          // of the property checks (relative, table_properties.hpp)
   InnerHullOptions inner;
   // The engine's settings (solver, threads, run_dir, generation.block_order_cap, verification, ...); the order

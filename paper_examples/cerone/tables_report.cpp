@@ -66,6 +66,10 @@ std::string CaseNotes(const TableCase& c) {
   std::string notes = fmt::format("Inner hull: {} certified witnesses ({} of them the engine's feasible points) from {} "
                                   "local solves, {:.1f} s.", c.inner.witnesses, c.inner.given_witnesses,
                                   c.inner.local_solves, c.inner.seconds);
+  if (c.box_from_horizon > 0 && !c.outer.empty())
+    notes += fmt::format(" The outer runs started in the box of the n = {} outer intervals (D^ss({}) lies inside "
+                         "D^ss({})), so the n = {} outer intervals lie inside those by construction.",
+                         c.box_from_horizon, c.horizon, c.box_from_horizon, c.horizon);
   for (const auto& [order, run] : c.outer)
     notes += fmt::format(" Order {}: {}, solver {}, {} SDP solves, {:.1f} s{}{}.", order, run.relaxation, run.solver,
                          run.sdp_solves, run.wall_seconds,
@@ -184,6 +188,7 @@ nlohmann::json CaseJson(const TableCase& c, double box) {
           {"inner_hull", {{"witnesses", c.inner.witnesses}, {"given_by_the_engine", c.inner.given_witnesses},
                           {"local_solves", c.inner.local_solves},
                           {"seconds", c.inner.seconds}}},
+          {"outer_box", c.outer_box}, {"outer_box_from_horizon", c.box_from_horizon},
           {"rows", rows}, {"outer_runs", runs}};
 }
 
@@ -200,7 +205,8 @@ nlohmann::json TablesJson(const TablesReport& report) {
                         {"seeds", o.seeds}, {"params", o.params}, {"box", o.box}, {"solver", o.bounds.solver},
                         {"row_block_order", o.bounds.generation.block_order_cap},
                         {"verify", o.bounds.generation.verify.enabled}, {"inner_random_starts", o.inner.random_starts},
-                        {"inner_restart_rounds", o.inner.restart_rounds}, {"tolerance", o.tolerance}}},
+                        {"inner_restart_rounds", o.inner.restart_rounds}, {"tolerance", o.tolerance},
+                        {"nest_horizons", o.nest_horizons}}},
           {"properties", PropertiesText(o.tolerance)},
           {"properties_hold", report.violations.empty()},
           {"violations", violations},

@@ -1,6 +1,7 @@
 #include "paper_examples/cerone/tables_run.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -33,12 +34,15 @@ relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuter
   if (!bounds.run_dir.empty())
     bounds.run_dir += fmt::format("/N{}_seed{}_snr{:g}_n{}", c.samples, c.seed, c.snr_db, c.horizon);
   log(fmt::format("{}: outer intervals at order {} ...", c.label(), order));
-  // A line per finished job (runs at order 3 take minutes per job), and the engine's messages ("resuming: ...").
+  // A line per finished job at most every 10 s of the phase and at its end (runs at order 3 take minutes per job;
+  // screens and reductions finish hundreds of jobs a second), and the engine's messages ("resuming: ...").
+  double last_line = -INFINITY;
   auto summary = relax::ComputeBounds(bounds, set, [&](const relax::BoundsProgress& p) {
-    if (p.total < 0) log("  " + p.phase);
-    else if (p.done > 0)
-      log(fmt::format("  [{}] {} of {} jobs, {:.0f} s{}", p.phase, p.done, p.total, p.elapsed_seconds,
-                      p.done < p.total ? fmt::format(", about {:.0f} s left", p.eta_seconds) : ""));
+    if (p.total < 0) return log("  " + p.phase);
+    if (p.done <= 0 || (p.done < p.total && p.elapsed_seconds < last_line + 10)) return;
+    last_line = p.done < p.total ? p.elapsed_seconds : -INFINITY;
+    log(fmt::format("  [{}] {} of {} jobs, {:.0f} s{}", p.phase, p.done, p.total, p.elapsed_seconds,
+                    p.done < p.total ? fmt::format(", about {:.0f} s left", p.eta_seconds) : ""));
   });
   log(fmt::format("{}: order {} done in {:.1f} s", c.label(), order, summary.wall_seconds));
   return summary;
@@ -46,9 +50,24 @@ relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuter
 
 }  // namespace
 
-TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log) {
+std::vector<std::pair<double, double>> OuterIntervalBox(const TableCase& c) {
+  auto box = c.outer_box;
+  for (const auto& [order, run] : c.outer)
+    for (const auto& iv : run.intervals) {
+      const auto k = std::find(c.names.begin(), c.names.end(), iv.name) - c.names.begin();
+      if (k >= static_cast<long>(box.size()) || !(iv.lower.value <= iv.upper.value)) continue;
+      const double pad = 1e-9 * std::max(1.0, iv.upper.value - iv.lower.value);
+      box[k].first = std::max(box[k].first, iv.lower.value - pad);
+      box[k].second = std::min(box[k].second, iv.upper.value + pad);
+    }
+  return box;
+}
+
+TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log,
+                  const std::vector<std::pair<double, double>>* start_box, int box_from_horizon) {
   const auto ex = SimulateCeroneExample(seed, options.samples, snr_db);
   const auto set = ExampleSet(ex, horizon, options.box);
+  const auto outer_set = start_box ? set.WithBox(*start_box) : set;
   TableCase c;
   c.horizon = horizon;
   c.snr_db = snr_db;
@@ -58,10 +77,15 @@ TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint
   c.samples = options.samples;
   c.names = set.layout().names;
   c.truth = CeroneExample::TrueParameters();
+  c.outer_box = outer_set.box();
+  c.box_from_horizon = start_box ? box_from_horizon : 0;
+  if (start_box)
+    log(fmt::format("{}: outer runs start in the box of the n = {} outer intervals (D^ss({}) lies inside D^ss({}))",
+                    c.label(), box_from_horizon, horizon, box_from_horizon));
   // The outer intervals first: their runs' certified feasible points seed the inner hull (the engine searches
   // every live orthant, the hull's own starts only the truth's and those around it).
   for (int order : options.orders)
-    if (options.outer_wanted(order, horizon, snr_db)) c.outer[order] = RunOuter(options, set, c, order, log);
+    if (options.outer_wanted(order, horizon, snr_db)) c.outer[order] = RunOuter(options, outer_set, c, order, log);
   std::vector<std::vector<double>> engine_points;
   for (const auto& [order, run] : c.outer)
     for (const auto& p : run.feasible_points) engine_points.push_back(p.point);
@@ -73,10 +97,18 @@ TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint
 }
 
 std::vector<TableCase> RunTables(const TablesOptions& options, const Log& log) {
+  std::vector<int> horizons = options.horizons;
+  std::sort(horizons.begin(), horizons.end());
   std::vector<TableCase> cases;
   for (double snr : options.snrs)
     for (uint64_t seed : options.seeds)
-      for (int n : options.horizons) cases.push_back(RunCase(options, n, snr, seed, log));
+      for (std::size_t i = 0; i < horizons.size(); ++i) {
+        const TableCase* shorter = i > 0 && options.nest_horizons ? &cases.back() : nullptr;
+        if (shorter && shorter->outer.empty()) shorter = nullptr;
+        const auto box = shorter ? OuterIntervalBox(*shorter) : std::vector<std::pair<double, double>>{};
+        cases.push_back(RunCase(options, horizons[i], snr, seed, log, shorter ? &box : nullptr,
+                                shorter ? shorter->horizon : 0));
+      }
   return cases;
 }
 

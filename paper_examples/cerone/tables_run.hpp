@@ -20,10 +20,19 @@ relax::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box);
 // Layout indices of the named parameters (empty names: every parameter).
 std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vector<std::string>& names);
 
-// One case: the realisation (seed, SNR), its inner hull at horizon n, and the outer runs wanted there.
-TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log);
+// The box of a case's outer intervals: per parameter the intersection of its runs' intervals (each is a valid
+// outer bound) with the case's own starting box, each interval widened outward by 1e-9 of its width against
+// rounding. Parameters without an interval keep the starting box.
+std::vector<std::pair<double, double>> OuterIntervalBox(const TableCase& c);
 
-// Every case of the tables, in the order (SNR, seed, horizon).
+// One case: the realisation (seed, SNR), its inner hull at horizon n, and the outer runs wanted there. The
+// outer runs start in `start_box` when given (the outer box of horizon `box_from_horizon` of the same
+// realisation), else in the prior box; the inner hull always searches the prior box.
+TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log,
+                  const std::vector<std::pair<double, double>>* start_box = nullptr, int box_from_horizon = 0);
+
+// Every case of the tables, in the order (SNR, seed, horizon ascending); with options.nest_horizons each
+// horizon's outer runs start in the outer box of the one before it.
 std::vector<TableCase> RunTables(const TablesOptions& options, const Log& log);
 
 // Inner half-widths over the paper's ones at one SNR (the horizons of `options` the paper prints), for the
