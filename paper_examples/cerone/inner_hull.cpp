@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "relax/edge_witness.hpp"
 
 namespace hw::cerone {
@@ -108,7 +110,8 @@ InnerInterval HullOf(const relax::HwOuterSet& set, const WitnessPool& pool, int 
 
 InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<double>& truth,
                            const std::vector<int>& params, const InnerHullOptions& options,
-                           const std::vector<std::vector<double>>& given) {
+                           const std::vector<std::vector<double>>& given,
+                           const std::function<void(const std::string&)>& progress) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   const auto t0 = std::chrono::steady_clock::now();
@@ -117,19 +120,31 @@ InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<doubl
     for (int k = 0; k < set.num_vars(); ++k) wanted.push_back(k);
   const auto objectives = Objectives(wanted);
   WitnessPool pool(set, options);
+  auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  double last_line = -INFINITY;
+  auto report = [&](const char* stage, std::size_t done, bool stage_end) {
+    if (!progress || (!stage_end && seconds() < last_line + 10)) return;
+    last_line = seconds();
+    progress(fmt::format("  [inner hull: {}] {} of {} objectives, {} local solves, {:.0f} s", stage, done,
+                         objectives.size(), pool.solves(), last_line));
+  };
   pool.Add(truth, -1);
   const std::size_t before_given = pool.witnesses().size();
   for (const auto& p : given) pool.Add(p, -1);
   const int given_witnesses = static_cast<int>(pool.witnesses().size() - before_given);
   // 1. From the truth, in its orthant.
   const int truth_orthant = set.orthant_of(truth);
-  for (std::size_t j = 0; j < objectives.size(); ++j)
+  for (std::size_t j = 0; j < objectives.size(); ++j) {
     pool.Search(static_cast<int>(j), objectives[j].first, objectives[j].second, truth, truth_orthant);
+    report("from the truth", j + 1, j + 1 == objectives.size());
+  }
   // 2. From pseudo-random points around the hull (fixed before the searches, so the order does not matter).
   const auto box = pool.WidenedHullBox();
-  for (std::size_t j = 0; j < objectives.size(); ++j)
+  for (std::size_t j = 0; j < objectives.size(); ++j) {
     for (const auto& start : relax::PseudoRandomPointsInBox(box, options.random_starts, options.seed * 1000003u + j))
       pool.Search(static_cast<int>(j), objectives[j].first, objectives[j].second, start);
+    report("pseudo-random starts", j + 1, j + 1 == objectives.size());
+  }
   // 3. From a more extreme witness that another objective's search found.
   std::vector<int> restarted_from(objectives.size(), -1);
   for (int round = 0; round < options.restart_rounds; ++round)
@@ -140,13 +155,14 @@ InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<doubl
       restarted_from[j] = best;
       const std::vector<double> start = pool.witnesses()[best].point;  // a copy: Search appends to the pool
       pool.Search(static_cast<int>(j), k, dir, start);
+      report("restarts", j + 1, false);
     }
   InnerHull hull;
   for (int k : wanted) hull.intervals.push_back(HullOf(set, pool, k));
   hull.witnesses = static_cast<int>(pool.witnesses().size());
   hull.given_witnesses = given_witnesses;
   hull.local_solves = pool.solves();
-  hull.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  hull.seconds = seconds();
   return hull;
 }
 

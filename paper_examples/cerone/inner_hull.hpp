@@ -12,6 +12,7 @@
 // a local search from one start misses far parts of a thin set, so the hull is only ever a lower bound of the
 // exact interval.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -57,9 +58,11 @@ struct InnerHull {
 Witness CertifyWitness(const relax::HwOuterSet& set, std::vector<double> point);
 
 // The inner hull of the parameters `params` (layout indices; empty = all) from `truth` (need not be feasible)
-// and the points `given` (each enters when it certifies, and is a restart point like any witness).
+// and the points `given` (each enters when it certifies, and is a restart point like any witness). `progress`
+// gets a line after each stage and at most every 10 s within one (at N = 1000 a hull takes minutes).
 InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<double>& truth,
                            const std::vector<int>& params, const InnerHullOptions& options = {},
-                           const std::vector<std::vector<double>>& given = {});
+                           const std::vector<std::vector<double>>& given = {},
+                           const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace hw::cerone

@@ -89,7 +89,7 @@ TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint
   std::vector<std::vector<double>> engine_points;
   for (const auto& [order, run] : c.outer)
     for (const auto& p : run.feasible_points) engine_points.push_back(p.point);
-  c.inner = ComputeInnerHull(set, c.truth, ParameterIndices(set, options.params), options.inner, engine_points);
+  c.inner = ComputeInnerHull(set, c.truth, ParameterIndices(set, options.params), options.inner, engine_points, log);
   log(fmt::format("{}: inner hull from {} witnesses ({} of {} given by the engine), {} local solves, {:.1f} s",
                   c.label(), c.inner.witnesses, c.inner.given_witnesses, engine_points.size(), c.inner.local_solves,
                   c.inner.seconds));
