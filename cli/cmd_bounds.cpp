@@ -11,6 +11,7 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
+#include "core/progress_throttle.hpp"
 #include "core/recording.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
@@ -367,16 +368,14 @@ void AddBoundsCommand(CLI::App& app) {
                "{} sign orthants, solver {}, jobs on {} ({} workers)\n",
                data.y.size(), o->data, o->na, o->nb, o->horizon, options.order, names.size(), set.num_orthants(),
                SolverText(options), options.executor->name(), options.executor->workers());
-    auto progress = [o](const relax::BoundsProgress& p) {
+    ProgressThrottle throttle(5.0);  // a line per phase start and end, and at most one every 5 s in between
+    auto progress = [o, &throttle](const relax::BoundsProgress& p) {
       if (o->quiet) return;
       if (p.total < 0) {  // a one-off message
         fmt::print(stderr, "{}\n", p.phase);
         return;
       }
-      // A line per phase start and end, and at most one every 5 s in between.
-      static double last_line = -1e9;
-      if (p.done > 0 && p.done < p.total && p.elapsed_seconds - last_line < 5.0) return;
-      last_line = p.elapsed_seconds;
+      if (!throttle.Due(p.elapsed_seconds, p.done <= 0 || p.done >= p.total)) return;
       fmt::print(stderr, "[{}] {}/{} jobs{}, elapsed {:.0f} s, ETA {:.0f} s\n", p.phase, p.done, p.total,
                  p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
                  p.elapsed_seconds, p.eta_seconds);

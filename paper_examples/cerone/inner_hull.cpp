@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "core/progress_throttle.hpp"
 #include "relax/edge_witness.hpp"
 
 namespace hw::cerone {
@@ -121,12 +122,12 @@ InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<doubl
   const auto objectives = Objectives(wanted);
   WitnessPool pool(set, options);
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-  double last_line = -INFINITY;
+  ProgressThrottle throttle(10.0);
   auto report = [&](const char* stage, std::size_t done, bool stage_end) {
-    if (!progress || (!stage_end && seconds() < last_line + 10)) return;
-    last_line = seconds();
+    const double now = seconds();
+    if (!progress || !throttle.Due(now, stage_end)) return;
     progress(fmt::format("  [inner hull: {}] {} of {} objectives, {} local solves, {:.0f} s", stage, done,
-                         objectives.size(), pool.solves(), last_line));
+                         objectives.size(), pool.solves(), now));
   };
   pool.Add(truth, -1);
   const std::size_t before_given = pool.witnesses().size();

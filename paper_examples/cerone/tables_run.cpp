@@ -1,10 +1,10 @@
 #include "paper_examples/cerone/tables_run.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 #include <fmt/format.h>
 
+#include "core/progress_throttle.hpp"
 #include "paper_examples/cerone/paper_table.hpp"
 
 namespace hw::cerone {
@@ -36,11 +36,12 @@ relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuter
   log(fmt::format("{}: outer intervals at order {} ...", c.label(), order));
   // A line per finished job at most every 10 s of the phase and at its end (runs at order 3 take minutes per job;
   // screens and reductions finish hundreds of jobs a second), and the engine's messages ("resuming: ...").
-  double last_line = -INFINITY;
+  ProgressThrottle throttle(10.0);
   auto summary = relax::ComputeBounds(bounds, set, [&](const relax::BoundsProgress& p) {
     if (p.total < 0) return log("  " + p.phase);
-    if (p.done <= 0 || (p.done < p.total && p.elapsed_seconds < last_line + 10)) return;
-    last_line = p.done < p.total ? p.elapsed_seconds : -INFINITY;
+    const bool phase_end = p.done >= p.total;
+    if (p.done <= 0 || !throttle.Due(p.elapsed_seconds, phase_end)) return;
+    if (phase_end) throttle.Reset();  // the next phase's clock starts at 0
     log(fmt::format("  [{}] {} of {} jobs, {:.0f} s{}", p.phase, p.done, p.total, p.elapsed_seconds,
                     p.done < p.total ? fmt::format(", about {:.0f} s left", p.eta_seconds) : ""));
   });
@@ -64,10 +65,10 @@ std::vector<std::pair<double, double>> OuterIntervalBox(const TableCase& c) {
 }
 
 TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log,
-                  const std::vector<std::pair<double, double>>* start_box, int box_from_horizon) {
+                  const TableCase* shorter) {
   const auto ex = SimulateCeroneExample(seed, options.samples, snr_db);
   const auto set = ExampleSet(ex, horizon, options.box);
-  const auto outer_set = start_box ? set.WithBox(*start_box) : set;
+  const auto outer_set = shorter ? set.WithBox(OuterIntervalBox(*shorter)) : set;
   TableCase c;
   c.horizon = horizon;
   c.snr_db = snr_db;
@@ -78,10 +79,10 @@ TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint
   c.names = set.layout().names;
   c.truth = CeroneExample::TrueParameters();
   c.outer_box = outer_set.box();
-  c.box_from_horizon = start_box ? box_from_horizon : 0;
-  if (start_box)
+  c.box_from_horizon = shorter ? shorter->horizon : 0;
+  if (shorter)
     log(fmt::format("{}: outer runs start in the box of the n = {} outer intervals (D^ss({}) lies inside D^ss({}))",
-                    c.label(), box_from_horizon, horizon, box_from_horizon));
+                    c.label(), c.box_from_horizon, horizon, c.box_from_horizon));
   // The outer intervals first: their runs' certified feasible points seed the inner hull (the engine searches
   // every live orthant, the hull's own starts only the truth's and those around it).
   for (int order : options.orders)
@@ -103,11 +104,8 @@ std::vector<TableCase> RunTables(const TablesOptions& options, const Log& log) {
   for (double snr : options.snrs)
     for (uint64_t seed : options.seeds)
       for (std::size_t i = 0; i < horizons.size(); ++i) {
-        const TableCase* shorter = i > 0 && options.nest_horizons ? &cases.back() : nullptr;
-        if (shorter && shorter->outer.empty()) shorter = nullptr;
-        const auto box = shorter ? OuterIntervalBox(*shorter) : std::vector<std::pair<double, double>>{};
-        cases.push_back(RunCase(options, horizons[i], snr, seed, log, shorter ? &box : nullptr,
-                                shorter ? shorter->horizon : 0));
+        const bool nest = i > 0 && options.nest_horizons && !cases.back().outer.empty();
+        cases.push_back(RunCase(options, horizons[i], snr, seed, log, nest ? &cases.back() : nullptr));
       }
   return cases;
 }

@@ -26,10 +26,10 @@ std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vecto
 std::vector<std::pair<double, double>> OuterIntervalBox(const TableCase& c);
 
 // One case: the realisation (seed, SNR), its inner hull at horizon n, and the outer runs wanted there. The
-// outer runs start in `start_box` when given (the outer box of horizon `box_from_horizon` of the same
-// realisation), else in the prior box; the inner hull always searches the prior box.
+// outer runs start in OuterIntervalBox(*shorter) when given (a shorter horizon's case of the same realisation
+// with outer runs), else in the prior box; the inner hull always searches the prior box.
 TableCase RunCase(const TablesOptions& options, int horizon, double snr_db, uint64_t seed, const Log& log,
-                  const std::vector<std::pair<double, double>>* start_box = nullptr, int box_from_horizon = 0);
+                  const TableCase* shorter = nullptr);
 
 // Every case of the tables, in the order (SNR, seed, horizon ascending); with options.nest_horizons each
 // horizon's outer runs start in the outer box of the one before it.
