@@ -236,7 +236,10 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
   for (const auto& r : summary.row_reduction) {
     std::string steps;
     for (const auto& c : r.at("per_step"))
-      if (c.contains("step"))
+      if (c.contains("error"))
+        steps += fmt::format("{}step {}: reduction failed ({}), every row of the orthant kept", steps.empty() ? "" : ", ",
+                             c.value("step", 0), c.at("error").get<std::string>());
+      else if (c.contains("step"))
         steps += fmt::format("{}step {}: {} of {}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
                              c.at("kept").get<int>(), c.at("rows").get<int>());
     fmt::print("exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);

@@ -253,18 +253,24 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     const HwOuterSet& set = set_for(box);
     const auto& all_rows = rows_for(box, l);
     if (kind == "reduce") {
+      // Rows never combine across horizon steps, so each step may be a job of its own ("step"; 0 = all).
+      const int only_step = spec.value("step", 0);
       std::vector<Polynomial> rows;
-      std::vector<int> steps;
-      for (const auto& d : all_rows) {
-        rows.push_back(d.g);
-        steps.push_back(d.s);
+      std::vector<int> steps, index;
+      for (std::size_t i = 0; i < all_rows.size(); ++i) {
+        if (only_step != 0 && all_rows[i].s != only_step) continue;
+        rows.push_back(all_rows[i].g);
+        steps.push_back(all_rows[i].s);
+        index.push_back(static_cast<int>(i));
       }
       std::vector<Polynomial> fixed = set.box_constraints();
       for (auto& g : set.sign_constraints(l)) fixed.push_back(std::move(g));
       const auto r = ReduceDataRows(options.reduction, rows, steps, fixed);
+      std::vector<int> kept;  // indices into all_rows
+      for (int k : r.kept) kept.push_back(index[k]);
       nlohmann::json counts = nlohmann::json::array();
       for (const auto& c : r.per_step) counts.push_back({{"step", c.step}, {"rows", c.rows}, {"kept", c.kept}});
-      return nlohmann::json{{"kept", r.kept}, {"per_step", counts}, {"linear_programs", r.linear_programs},
+      return nlohmann::json{{"kept", kept}, {"per_step", counts}, {"linear_programs", r.linear_programs},
                             {"seconds", r.seconds}}
           .dump();
     }

@@ -3,7 +3,8 @@
 // workers or on other MPI ranks (sdp/job_executor.hpp). A job depends only on (options, set) and its spec, never
 // on which worker runs it or when, so results do not depend on timing:
 //   {"kind": "lp", "l"}                          LP screen of orthant l (emptiness, verified);
-//   {"kind": "reduce", "l"}                      exact row reduction of orthant l (relax/row_reduction.hpp);
+//   {"kind": "reduce", "l", "box", ["step"]}     exact row reduction of orthant l's data rows of horizon step
+//                                                `step` (all steps without it; relax/row_reduction.hpp);
 //   {"kind": "witness", "l", "param", "dir", "starts", "rows"}
 //                                                a feasible local extreme of a parameter over orthant l, from the
 //                                                starts in turn, over the data rows `rows` (relax/edge_witness.hpp);

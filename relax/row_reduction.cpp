@@ -145,29 +145,50 @@ RowReductionResult ReduceDataRows(const RowReductionOptions& options, const std:
 namespace hw::relax {
 
 void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants) {
+  // One job per (orthant, horizon step): rows of different steps never combine, so the result is the same as one
+  // job per orthant, while the steps run in parallel and each finished step shows in the progress.
+  struct StepJob {
+    std::size_t orthant;
+    int step;
+  };
   std::vector<std::pair<std::string, std::string>> jobs;
-  std::vector<std::size_t> job_orthant;
+  std::vector<StepJob> job_of;
   for (std::size_t k = 0; k < orthants.size(); ++k) {
     const OrthantWork& o = orthants[k];
     if (o.empty()) continue;
-    std::string key = fmt::format("reduce_l{}", o.index);
-    if (o.box != ctx.set.box()) key += "_b" + BoxHash(o.box);
-    if (!ctx.options.reduction.enabled) key += "_off";
-    jobs.push_back({nlohmann::json{{"kind", "reduce"}, {"l", o.index}, {"box", o.box}}.dump(), key});
-    job_orthant.push_back(k);
+    for (int s = 1; s <= ctx.set.horizon(); ++s) {
+      std::string key = fmt::format("reduce_l{}_s{}", o.index, s);
+      if (o.box != ctx.set.box()) key += "_b" + BoxHash(o.box);
+      if (!ctx.options.reduction.enabled) key += "_off";
+      jobs.push_back({nlohmann::json{{"kind", "reduce"}, {"l", o.index}, {"box", o.box}, {"step", s}}.dump(), key});
+      job_of.push_back({k, s});
+    }
   }
   ctx.progress.Phase("exact reduction of data rows", static_cast<int>(jobs.size()));
+  std::map<std::size_t, std::map<int, nlohmann::json>> answers;  // orthant -> step -> answer
   DispatchJobs(ctx, jobs, [&](std::size_t i, const nlohmann::json& answer, bool) {
-    OrthantWork& o = orthants[job_orthant[i]];
-    if (answer.contains("job_error")) {  // the reduction only saves work: a failed one keeps every row
-      o.reduction = {nlohmann::json{{"error", answer.at("job_error")}}};
-      ctx.progress.Done();
-      return;
-    }
-    o.rows = answer.at("kept").get<std::vector<int>>();
-    o.reduction = answer.at("per_step").get<std::vector<nlohmann::json>>();
+    answers[job_of[i].orthant][job_of[i].step] = answer;
     ctx.progress.Done();
   });
+  for (auto& [k, by_step] : answers) {
+    OrthantWork& o = orthants[k];
+    std::vector<int> kept;
+    std::vector<nlohmann::json> per_step;
+    bool failed = false;
+    for (const auto& [s, answer] : by_step) {
+      if (answer.contains("job_error")) {
+        failed = true;
+        per_step.push_back({{"step", s}, {"error", answer.at("job_error")}});
+        continue;
+      }
+      for (int r : answer.at("kept").get<std::vector<int>>()) kept.push_back(r);
+      for (const auto& c : answer.at("per_step")) per_step.push_back(c);
+    }
+    o.reduction = per_step;
+    if (failed) continue;  // the reduction only saves work: an orthant with a failed step keeps every row
+    std::sort(kept.begin(), kept.end());
+    o.rows = kept;
+  }
 }
 
 }  // namespace hw::relax

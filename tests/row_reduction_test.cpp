@@ -13,6 +13,7 @@
 #include "relax/constraint_generation.hpp"
 #include "relax/hw_outer_set.hpp"
 #include "relax/row_reduction.hpp"
+#include "relax/set_membership.hpp"
 
 namespace hw::relax {
 namespace {
@@ -140,6 +141,33 @@ TEST(RowReduction, ReducedAndUnreducedRelaxationsGiveTheSameBound) {
   EXPECT_GT(dropped_total, 0) << "the instances should have implied rows, or the test proves nothing";
   RecordProperty("worst_bound_difference", std::to_string(worst_difference));
   std::printf("rows dropped: %d; worst |reduced - full| bound difference: %.3g\n", dropped_total, worst_difference);
+}
+
+TEST(RowReduction, OneJobPerHorizonStepKeepsTheRowsOfOneJobPerOrthant) {
+  // Rows of different steps never combine, so the engine's per-step reduce jobs keep exactly the rows that one
+  // job over every row keeps (and their counts per step match).
+  const auto [set, truth] = RandomSet(4, 40, 3);
+  const int l = set.orthant_of(truth);
+  const auto job = MakeJobFunction(BoundsOptions{}, set);
+  auto reduce = [&](int step) {
+    nlohmann::json spec{{"kind", "reduce"}, {"l", l}, {"box", set.box()}};
+    if (step != 0) spec["step"] = step;
+    return nlohmann::json::parse(job(spec.dump()));
+  };
+  const auto whole = reduce(0);
+  std::vector<int> union_of_steps;
+  nlohmann::json counts = nlohmann::json::array();
+  for (int s = 1; s <= set.horizon(); ++s) {
+    const auto part = reduce(s);
+    ASSERT_EQ(part.at("per_step").size(), 1u);
+    EXPECT_EQ(part.at("per_step")[0].at("step"), s);
+    counts.push_back(part.at("per_step")[0]);
+    for (int r : part.at("kept")) union_of_steps.push_back(r);
+  }
+  std::sort(union_of_steps.begin(), union_of_steps.end());
+  EXPECT_EQ(union_of_steps, whole.at("kept").get<std::vector<int>>());
+  EXPECT_EQ(counts, whole.at("per_step"));
+  EXPECT_LT(union_of_steps.size(), set.data_constraints(l).size()) << "some rows should be implied";
 }
 
 }  // namespace
