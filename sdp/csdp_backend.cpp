@@ -212,7 +212,9 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     tls_csdp.iterations = 0;
     initsoln(d.n, d.k, d.C, d.a, d.constraints, &d.X, &d.y, &d.Z);  // easy_sdp starts from (X, y, Z)
     d.solution_allocated = true;
+    ForgetSchurStructure();  // op_o() builds the structure of this solve on its first call
     ret = easy_sdp(d.n, d.k, d.C, d.a, d.constraints, 0.0, &d.X, &d.y, &d.Z, &pobj, &dobj);
+    ForgetSchurStructure();
     out.iterations = tls_csdp.iterations;
     tls_csdp.active = false;
     out.solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();

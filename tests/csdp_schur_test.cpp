@@ -1,6 +1,7 @@
 // CSDP's Schur complement as hwbounds assembles it (sdp/csdp_schur.cpp, op_o): on random block structures with
 // every kind of block (diagonal, small and large matrix blocks, blocks no constraint touches), the upper
-// triangle of O equals tr(A_i Z^-1 A_j X) computed from dense matrices.
+// triangle of O equals tr(A_i Z^-1 A_j X) computed from dense matrices, also when the structure kept from the
+// solve's first call is read again.
 #include <map>
 #include <random>
 #include <set>
@@ -118,7 +119,12 @@ class RandomCsdpProblem {
     struct blockmatrix x{static_cast<int>(blocks_.size()), xrec_.data()};
     struct blockmatrix zi{static_cast<int>(blocks_.size()), zrec_.data()};
     struct blockmatrix unused{0, nullptr};
+    // Twice, as in two iterations of one solve: the second call reads the structure the first one cached.
     op_o(k_, constraints_.data(), byblocks_.data(), zi, x, o.data(), unused, unused);
+    const std::vector<double> first = o;
+    op_o(k_, constraints_.data(), byblocks_.data(), zi, x, o.data(), unused, unused);
+    hw::sdp::ForgetSchurStructure();  // the end of the solve (csdp_backend.cpp)
+    EXPECT_EQ(o, first);
     MatrixXd out = MatrixXd::Zero(k_, k_);
     for (int j = 0; j < k_; ++j)
       for (int i = 0; i <= j; ++i) out(i, j) = o[static_cast<std::size_t>(j) * ld + i];
