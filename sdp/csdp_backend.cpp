@@ -1,4 +1,5 @@
 #include "sdp/csdp_backend.hpp"
+#include "sdp/csdp_operators.hpp"
 #include "sdp/csdp_schur.hpp"
 
 #include <chrono>
@@ -212,9 +213,12 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     tls_csdp.iterations = 0;
     initsoln(d.n, d.k, d.C, d.a, d.constraints, &d.X, &d.y, &d.Z);  // easy_sdp starts from (X, y, Z)
     d.solution_allocated = true;
-    ForgetSchurStructure();  // op_o() builds the structure of this solve on its first call
+    // op_o(), op_a() and op_at() copy this solve's constraint structure on their first call.
+    ForgetSchurStructure();
+    ForgetOperatorStructure();
     ret = easy_sdp(d.n, d.k, d.C, d.a, d.constraints, 0.0, &d.X, &d.y, &d.Z, &pobj, &dobj);
     ForgetSchurStructure();
+    ForgetOperatorStructure();
     out.iterations = tls_csdp.iterations;
     tls_csdp.active = false;
     out.solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
@@ -249,7 +253,8 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     std::free(workvec);
   }
   out.details = {{"return_code", ret}, {"pobj", pobj}, {"dobj", dobj}, {"iterations", out.iterations},
-                 {"lock_wait_seconds", wait_seconds}, {"schur_assembly", CsdpSchurAssembly()}};
+                 {"lock_wait_seconds", wait_seconds}, {"schur_assembly", CsdpSchurAssembly()},
+                 {"linear_operators", CsdpOperators()}};
 
   // CSDP 6.2 return codes (CSDP user's guide; its primal is max tr(CX), A(X) = a, X >= 0):
   //   0 solved; 1 primal infeasible = no X = our problem unbounded below (y holds the ray);

@@ -91,6 +91,8 @@ class SchurMatrix {
     if (i > j) std::swap(i, j);
     o_[(static_cast<long>(j) - 1) * ld_ + i - 1] += v;
   }
+  // Column j (1-based) of the stored upper triangle, indexed by i - 1.
+  double* Column(int j) { return o_ + (static_cast<long>(j) - 1) * ld_; }
 
  private:
   int k_, ld_;
@@ -148,13 +150,17 @@ void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const BlockView
     for (std::size_t e = 0; e < cs[i].value.size(); ++e)
       ut.col(i) += cs[i].value[e] * kernel.col(cs[i].packed[e]);
   const Matrix u = ut.transpose();
-  // Column j of the block's contribution, rows i <= j: sum over A_j's entries of value * U(:, position).
+  // Column j of the block's contribution, rows i <= j: sum over A_j's entries of value * U(:, position). The
+  // constraints ascend, so (i, j) lies in O's upper triangle; their rows in O are read from one contiguous array.
+  std::vector<int> row_in_o(m);
+  for (int i = 0; i < m; ++i) row_in_o[i] = cs[i].constraint - 1;
   Eigen::VectorXd column(m);
   for (int j = 0; j < m; ++j) {
     column.head(j + 1).setZero();
     for (std::size_t e = 0; e < cs[j].value.size(); ++e)
       column.head(j + 1) += cs[j].value[e] * u.col(cs[j].packed[e]).head(j + 1);
-    for (int i = 0; i <= j; ++i) o.Add(cs[i].constraint, cs[j].constraint, column[i]);
+    double* o_column = o.Column(cs[j].constraint);
+    for (int i = 0; i <= j; ++i) o_column[row_in_o[i]] += column[i];
   }
 }
 

@@ -1,10 +1,13 @@
 // CSDP's Schur complement as hwbounds assembles it (sdp/csdp_schur.cpp, op_o): on random block structures with
 // every kind of block (diagonal, small and large matrix blocks, blocks no constraint touches), the upper
 // triangle of O equals tr(A_i Z^-1 A_j X) computed from dense matrices, also when the structure kept from the
-// solve's first call is read again.
+// solve's first call is read again; A(X) (op_a) and A^T(y) (op_at, sdp/csdp_operators.cpp) match dense traces and sums.
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -14,6 +17,7 @@ extern "C" {
 #include <csdp/declarations.h>
 }
 
+#include "sdp/csdp_operators.hpp"
 #include "sdp/csdp_schur.hpp"
 
 namespace {
@@ -131,6 +135,55 @@ class RandomCsdpProblem {
     return out;
   }
 
+  // A(X) from op_a(), called twice as in one solve (the second call reads the cached copy), against tr(A_i X).
+  double WorstOpAError() {
+    struct blockmatrix x{static_cast<int>(blocks_.size()), xrec_.data()};
+    std::vector<double> got(k_ + 1), again(k_ + 1);
+    op_a(k_, constraints_.data(), x, got.data());
+    op_a(k_, constraints_.data(), x, again.data());
+    hw::sdp::ForgetOperatorStructure();
+    EXPECT_EQ(got, again);
+    double worst = 0.0;
+    for (int i = 1; i <= k_; ++i) {
+      double want = 0.0;
+      for (std::size_t b = 0; b < blocks_.size(); ++b) want += (a_[i][b] * x_[b]).trace();
+      worst = std::max(worst, std::abs(got[i] - want) / (1.0 + std::abs(want)));
+    }
+    return worst;
+  }
+
+  // A^T(y) from op_at() into a block matrix holding garbage (op_at zeroes it), against sum_i y_i A_i.
+  double WorstOpAtError(unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> uni(-1.0, 1.0);
+    std::vector<double> y(k_ + 1, 0.0);
+    for (int i = 1; i <= k_; ++i) y[i] = i % 5 == 0 ? 0.0 : uni(rng);  // some zero multipliers, skipped by op_at
+    std::vector<std::vector<double>> data;
+    std::vector<struct blockrec> rec(blocks_.size() + 1);
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      const int n = blocks_[b].size;
+      data.push_back(std::vector<double>(blocks_[b].diagonal ? n + 1 : n * n, 7.0));
+      rec[b + 1].blocksize = n;
+      rec[b + 1].blockcategory = blocks_[b].diagonal ? DIAG : MATRIX;
+      rec[b + 1].data.mat = data.back().data();
+    }
+    op_at(k_, y.data(), constraints_.data(), {static_cast<int>(blocks_.size()), rec.data()});
+    hw::sdp::ForgetOperatorStructure();
+    double worst = 0.0;
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      const int n = blocks_[b].size;
+      MatrixXd want = MatrixXd::Zero(n, n);
+      for (int i = 1; i <= k_; ++i) want += y[i] * a_[i][b];
+      for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) {
+          if (blocks_[b].diagonal && r != c) continue;
+          const double got = blocks_[b].diagonal ? data[b][r + 1] : data[b][static_cast<std::size_t>(c) * n + r];
+          worst = std::max(worst, std::abs(got - want(r, c)));
+        }
+    }
+    return worst;
+  }
+
   // tr(A_i Z^-1 A_j X) from dense matrices, upper triangle.
   MatrixXd Reference() const {
     MatrixXd out = MatrixXd::Zero(k_, k_);
@@ -170,6 +223,18 @@ TEST(CsdpSchur, EveryKindOfBlockGivesTrAiZinvAjX) {
     }
   }
   EXPECT_NE(std::string(hw::sdp::CsdpSchurAssembly()).find("csdp_schur"), std::string::npos);
+}
+
+TEST(CsdpOperators, OpAAndOpAtMatchDenseTracesAndSums) {
+  const std::vector<Block> blocks{{true, 7}, {false, 1}, {false, 9}, {false, 46}, {false, 60}, {false, 5}};
+  for (const int k : {1, 30, 31}) {
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+      RandomCsdpProblem problem(blocks, k, seed);
+      EXPECT_LE(problem.WorstOpAError(), 1e-13) << "k " << k << " seed " << seed;
+      EXPECT_LE(problem.WorstOpAtError(seed), 1e-13) << "k " << k << " seed " << seed;
+    }
+  }
+  EXPECT_NE(std::string(hw::sdp::CsdpOperators()).find("csdp_operators"), std::string::npos);
 }
 
 }  // namespace
