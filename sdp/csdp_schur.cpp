@@ -56,6 +56,26 @@ std::vector<BlockConstraint> ConstraintsOfBlock(struct sparseblock* first) {
   return out;
 }
 
+// A block's constraints, also as flat arrays (constraint c's entries at [start[c], start[c + 1])) for the loops
+// that visit every entry many times.
+struct BlockData {
+  std::vector<BlockConstraint> constraints;  // ascending constraint numbers
+  std::vector<int> start, packed;
+  std::vector<double> value;
+};
+
+BlockData DataOfBlock(struct sparseblock* first) {
+  BlockData d;
+  d.constraints = ConstraintsOfBlock(first);
+  d.start.push_back(0);
+  for (const auto& c : d.constraints) {
+    d.packed.insert(d.packed.end(), c.packed.begin(), c.packed.end());
+    d.value.insert(d.value.end(), c.value.begin(), c.value.end());
+    d.start.push_back(static_cast<int>(d.value.size()));
+  }
+  return d;
+}
+
 // The constraints of every block, read once per solve: the structure does not change between iterations, and
 // rebuilding it in every op_o() call cost about a fifth of the assembly (allocation included; perf on the
 // bundled example). One solve runs at a time in a process (csdp_backend.cpp serialises easy_sdp()), and
@@ -63,21 +83,21 @@ std::vector<BlockConstraint> ConstraintsOfBlock(struct sparseblock* first) {
 struct SchurStructure {
   struct sparseblock** byblocks = nullptr;
   int k = 0;
-  std::vector<std::vector<BlockConstraint>> blocks;  // 1-based like CSDP's blocks
+  std::vector<BlockData> blocks;  // 1-based like CSDP's blocks
 };
 SchurStructure& CachedStructure() {
   static SchurStructure structure;
   return structure;
 }
 
-const std::vector<std::vector<BlockConstraint>>& StructureOf(int k, struct sparseblock** byblocks, int nblocks) {
+const std::vector<BlockData>& StructureOf(int k, struct sparseblock** byblocks, int nblocks) {
   SchurStructure& s = CachedStructure();
   if (s.byblocks != byblocks || s.k != k || static_cast<int>(s.blocks.size()) != nblocks + 1) {
     s.byblocks = byblocks;
     s.k = k;
     s.blocks.assign(nblocks + 1, {});
     for (int b = 1; b <= nblocks; ++b)
-      if (byblocks[b] != nullptr) s.blocks[b] = ConstraintsOfBlock(byblocks[b]);
+      if (byblocks[b] != nullptr) s.blocks[b] = DataOfBlock(byblocks[b]);
   }
   return s.blocks;
 }
@@ -93,6 +113,23 @@ class SchurMatrix {
   }
   // Column j (1-based) of the stored upper triangle, indexed by i - 1.
   double* Column(int j) { return o_ + (static_cast<long>(j) - 1) * ld_; }
+  // A large block writes row i's terms down column i of the (otherwise unused) lower triangle, contiguously; this
+  // adds each strictly lower (j, i) into (i, j) and clears it. `index` (0-based, ascending) are the block's
+  // constraints; tiles keep both reads in cache.
+  void FoldLowerIntoUpper(const std::vector<int>& index) {
+    constexpr int kTile = 32;
+    const int m = static_cast<int>(index.size());
+    for (int j0 = 0; j0 < m; j0 += kTile)
+      for (int i0 = 0; i0 <= j0; i0 += kTile)
+        for (int j = j0; j < std::min(j0 + kTile, m); ++j) {
+          double* upper = o_ + static_cast<long>(index[j]) * ld_;
+          for (int i = i0; i < std::min(i0 + kTile, j); ++i) {
+            double& lower = o_[static_cast<long>(index[i]) * ld_ + index[j]];
+            upper[index[i]] += lower;
+            lower = 0.0;
+          }
+        }
+  }
 
  private:
   int k_, ld_;
@@ -138,18 +175,23 @@ Matrix PackedKernel(const BlockView& zi, const BlockView& x) {
 }
 
 // Small matrix block: U = A_B K, then O_ij += A_j . U_i.
-void AddSmallMatrixBlock(const std::vector<BlockConstraint>& cs, const BlockView& zi, const BlockView& x,
-                         SchurMatrix& o) {
+void AddSmallMatrixBlock(const BlockData& block, const BlockView& zi, const BlockView& x, SchurMatrix& o) {
+  const auto& cs = block.constraints;
   const Matrix kernel = PackedKernel(zi, x);
   const int packed = static_cast<int>(kernel.rows());
-  // U = A_B K (constraints x packed positions), built column by column as K A_i (contiguous: K is symmetric),
-  // then transposed once.
+  // U = A_B K (constraints x packed positions), one column at a time: U(i, p) = sum over A_i's entries of
+  // value * K(position, p), reading one column of K (a transpose of A_B K built by rows cost more than this).
   const int m = static_cast<int>(cs.size());
-  Matrix ut = Matrix::Zero(packed, m);
-  for (int i = 0; i < m; ++i)
-    for (std::size_t e = 0; e < cs[i].value.size(); ++e)
-      ut.col(i) += cs[i].value[e] * kernel.col(cs[i].packed[e]);
-  const Matrix u = ut.transpose();
+  Matrix u(m, packed);
+  for (int p = 0; p < packed; ++p) {
+    const double* k_column = kernel.col(p).data();
+    double* u_column = u.col(p).data();
+    for (int i = 0; i < m; ++i) {
+      double sum = 0.0;
+      for (int e = block.start[i]; e < block.start[i + 1]; ++e) sum += block.value[e] * k_column[block.packed[e]];
+      u_column[i] = sum;
+    }
+  }
   // Column j of the block's contribution, rows i <= j: sum over A_j's entries of value * U(:, position). The
   // constraints ascend, so (i, j) lies in O's upper triangle; their rows in O are read from one contiguous array.
   std::vector<int> row_in_o(m);
@@ -188,15 +230,21 @@ void AddLargeMatrixBlock(const std::vector<BlockConstraint>& cs, const BlockView
     for (int r = 0; r < nr; ++r) zsub.col(r) = zi.col(rows[r]);
     w.noalias() = zsub * t;
     for (int r : rows) slot[r] = -1;
+    // O(i, j), j >= i, goes to (j, i) in column i: contiguous writes (row-wise ones into the upper triangle missed
+    // the cache at every j); FoldLowerIntoUpper moves them up. The diagonal is the same element either way.
+    double* lower_column = o.Column(a.constraint);
     for (int j = i; j < m; ++j) {
       double sum = 0.0;
       for (std::size_t e = 0; e < cs[j].value.size(); ++e) {
         const int r = cs[j].row[e], s = cs[j].col[e];
         sum += cs[j].value[e] * (r == s ? w(r, s) : w(r, s) + w(s, r));
       }
-      o.Add(a.constraint, cs[j].constraint, sum);
+      lower_column[cs[j].constraint - 1] += sum;
     }
   }
+  std::vector<int> index(m);
+  for (int i = 0; i < m; ++i) index[i] = cs[i].constraint - 1;
+  o.FoldLowerIntoUpper(index);
 }
 
 BlockView View(const struct blockrec& block) {
@@ -224,12 +272,13 @@ extern "C" void op_o(int k, struct constraintmatrix* /*constraints*/, struct spa
   const auto& structure = StructureOf(k, byblocks, X.nblocks);
   for (int b = 1; b <= X.nblocks; ++b) {
     if (byblocks[b] == nullptr) continue;
-    const auto& cs = structure[b];
+    const auto& block = structure[b];
+    const auto& cs = block.constraints;
     const struct blockrec& xb = X.blocks[b];
     if (xb.blockcategory == DIAG) {
       AddDiagonalBlock(cs, Zi.blocks[b].data.vec, xb.data.vec, xb.blocksize, o);
     } else if (xb.blocksize <= kPackedKernelMaxSize) {
-      AddSmallMatrixBlock(cs, View(Zi.blocks[b]), View(xb), o);
+      AddSmallMatrixBlock(block, View(Zi.blocks[b]), View(xb), o);
     } else {
       AddLargeMatrixBlock(cs, View(Zi.blocks[b]), View(xb), o);
     }
