@@ -213,12 +213,10 @@ SdpSummary SolveWithCsdp(const SdpOptions& options, const LmiProblem& problem) {
     tls_csdp.iterations = 0;
     initsoln(d.n, d.k, d.C, d.a, d.constraints, &d.X, &d.y, &d.Z);  // easy_sdp starts from (X, y, Z)
     d.solution_allocated = true;
-    // op_o(), op_a() and op_at() copy this solve's constraint structure on their first call.
-    ForgetSchurStructure();
-    ForgetOperatorStructure();
-    ret = easy_sdp(d.n, d.k, d.C, d.a, d.constraints, 0.0, &d.X, &d.y, &d.Z, &pobj, &dobj);
-    ForgetSchurStructure();
-    ForgetOperatorStructure();
+    {
+      const CsdpSolveScope scope;  // op_o(), op_a() and op_at() keep this solve's constraint structure
+      ret = easy_sdp(d.n, d.k, d.C, d.a, d.constraints, 0.0, &d.X, &d.y, &d.Z, &pobj, &dobj);
+    }
     out.iterations = tls_csdp.iterations;
     tls_csdp.active = false;
     out.solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();

@@ -6,6 +6,8 @@ extern "C" {
 #include <csdp/declarations.h>
 }
 
+#include "sdp/csdp_schur.hpp"
+
 // CSDP's op_a() and op_at() walk each constraint's linked list of sparse blocks and recompute every entry's
 // position in every call; on the moment relaxations (tens of thousands of entries, a few calls per iteration)
 // that was about 40 % of a solve (perf, benchmarks/setmembership_sdp_bench). Here the constraints are copied once
@@ -27,8 +29,8 @@ struct Segment {
   int begin, end;  // into FlatOperators::entries
 };
 
-// One solve runs at a time in a process (csdp_backend.cpp serialises easy_sdp()), and ForgetOperatorStructure()
-// ends each one, so a later solve never reads an earlier one's copy.
+// Kept for the solve of the thread inside a CsdpSolveScope (one at a time: easy_sdp() runs under CsdpMutex);
+// the scope's ends drop it, so a later solve never reads an earlier one's copy.
 struct FlatOperators {
   struct constraintmatrix* constraints = nullptr;
   int k = 0;
@@ -41,10 +43,9 @@ FlatOperators& Cached() {
   static FlatOperators flat;
   return flat;
 }
+thread_local bool tls_in_solve_scope = false;
 
-const FlatOperators& FlatOf(int k, struct constraintmatrix* constraints) {
-  FlatOperators& f = Cached();
-  if (f.constraints == constraints && f.k == k) return f;
+void Flatten(int k, struct constraintmatrix* constraints, FlatOperators& f) {
   f = {};
   f.constraints = constraints;
   f.k = k;
@@ -63,12 +64,34 @@ const FlatOperators& FlatOf(int k, struct constraintmatrix* constraints) {
     }
   }
   f.first_segment[k + 1] = static_cast<int>(f.segments.size());
+}
+
+// The solve's cached copy inside a CsdpSolveScope, else `local` filled for this call.
+const FlatOperators& FlatOf(int k, struct constraintmatrix* constraints, FlatOperators& local) {
+  if (!tls_in_solve_scope) {
+    Flatten(k, constraints, local);
+    return local;
+  }
+  FlatOperators& f = Cached();
+  if (f.constraints != constraints || f.k != k) Flatten(k, constraints, f);
   return f;
 }
 
 }  // namespace
 
-void ForgetOperatorStructure() { Cached() = {}; }
+CsdpSolveScope::CsdpSolveScope() {
+  Cached() = {};
+  ForgetSchurStructure();
+  tls_in_solve_scope = true;
+}
+
+CsdpSolveScope::~CsdpSolveScope() {
+  tls_in_solve_scope = false;
+  Cached() = {};
+  ForgetSchurStructure();
+}
+
+bool InCsdpSolveScope() { return tls_in_solve_scope; }
 
 #ifdef HW_LIBSDP_OPERATORS
 const char* CsdpOperators() { return "libsdp op_a, op_at (HWBOUNDS_LIBSDP_OPERATORS)"; }
@@ -80,7 +103,8 @@ const char* CsdpOperators() { return "hwbounds flat operators (sdp/csdp_operator
 
 // result[i] = A_i . X
 extern "C" void op_a(int k, struct constraintmatrix* constraints, struct blockmatrix X, double* result) {
-  const auto& f = hw::sdp::FlatOf(k, constraints);
+  hw::sdp::FlatOperators local;
+  const auto& f = hw::sdp::FlatOf(k, constraints, local);
   for (int i = 1; i <= k; ++i) {
     double contrib = 0.0;
     for (int s = f.first_segment[i]; s < f.first_segment[i + 1]; ++s) {
@@ -104,7 +128,8 @@ extern "C" void op_a(int k, struct constraintmatrix* constraints, struct blockma
 
 // result = sum_i y_i A_i
 extern "C" void op_at(int k, double* y, struct constraintmatrix* constraints, struct blockmatrix result) {
-  const auto& f = hw::sdp::FlatOf(k, constraints);
+  hw::sdp::FlatOperators local;
+  const auto& f = hw::sdp::FlatOf(k, constraints, local);
   zero_mat(result);
   for (int i = 1; i <= k; ++i) {
     if (y[i] == 0.0) continue;

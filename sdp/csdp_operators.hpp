@@ -8,7 +8,17 @@ namespace hw::sdp {
 // from the static hw_sdp archive ahead of libsdp.a's own.
 const char* CsdpOperators();
 
-// Drops the flat copy of the constraints of the solve in progress; called around every easy_sdp().
-void ForgetOperatorStructure();
+// The calling thread's easy_sdp() call, made under CsdpMutex (csdp_backend.cpp), lies between construction and
+// destruction: inside it op_o(), op_a() and op_at() keep the solve's constraint structure from their first call to
+// the last (the structure of a solve does not change); any other call, on any thread (CSDP's pinfeas() and
+// dinfeas() after a solve, outside the lock), copies the structure for that call only.
+class CsdpSolveScope {
+ public:
+  CsdpSolveScope();
+  ~CsdpSolveScope();
+  CsdpSolveScope(const CsdpSolveScope&) = delete;
+  CsdpSolveScope& operator=(const CsdpSolveScope&) = delete;
+};
+bool InCsdpSolveScope();
 
 }  // namespace hw::sdp

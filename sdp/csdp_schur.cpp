@@ -1,5 +1,7 @@
 #include "sdp/csdp_schur.hpp"
 
+#include "sdp/csdp_operators.hpp"
+
 #include <algorithm>
 #include <vector>
 
@@ -78,8 +80,8 @@ BlockData DataOfBlock(struct sparseblock* first) {
 
 // The constraints of every block, read once per solve: the structure does not change between iterations, and
 // rebuilding it in every op_o() call cost about a fifth of the assembly (allocation included; perf on the
-// bundled example). One solve runs at a time in a process (csdp_backend.cpp serialises easy_sdp()), and
-// ForgetSchurStructure() ends each one, so a later solve never sees an earlier solve's structure.
+// bundled example). Kept only inside a CsdpSolveScope (csdp_operators.hpp), whose ends drop it, so a later solve
+// never sees an earlier solve's structure.
 struct SchurStructure {
   struct sparseblock** byblocks = nullptr;
   int k = 0;
@@ -90,8 +92,9 @@ SchurStructure& CachedStructure() {
   return structure;
 }
 
-const std::vector<BlockData>& StructureOf(int k, struct sparseblock** byblocks, int nblocks) {
-  SchurStructure& s = CachedStructure();
+// The solve's cached structure inside a CsdpSolveScope, else `local` filled for this call.
+const std::vector<BlockData>& StructureOf(int k, struct sparseblock** byblocks, int nblocks, SchurStructure& local) {
+  SchurStructure& s = InCsdpSolveScope() ? CachedStructure() : local;
   if (s.byblocks != byblocks || s.k != k || static_cast<int>(s.blocks.size()) != nblocks + 1) {
     s.byblocks = byblocks;
     s.k = k;
@@ -269,7 +272,8 @@ extern "C" void op_o(int k, struct constraintmatrix* /*constraints*/, struct spa
   using namespace hw::sdp;
   SchurMatrix o(k, O);
   o.Zero();
-  const auto& structure = StructureOf(k, byblocks, X.nblocks);
+  SchurStructure local;
+  const auto& structure = StructureOf(k, byblocks, X.nblocks, local);
   for (int b = 1; b <= X.nblocks; ++b) {
     if (byblocks[b] == nullptr) continue;
     const auto& block = structure[b];

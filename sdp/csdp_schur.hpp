@@ -8,7 +8,7 @@ namespace hw::sdp {
 // hw_sdp archive ahead of libsdp.a's own.
 const char* CsdpSchurAssembly();
 
-// Drops the constraint structure op_o() keeps for the solve in progress; called after every easy_sdp().
+// Drops the constraint structure op_o() keeps for the solve in progress (by CsdpSolveScope, csdp_operators.hpp).
 void ForgetSchurStructure();
 
 }  // namespace hw::sdp

@@ -123,12 +123,17 @@ class RandomCsdpProblem {
     struct blockmatrix x{static_cast<int>(blocks_.size()), xrec_.data()};
     struct blockmatrix zi{static_cast<int>(blocks_.size()), zrec_.data()};
     struct blockmatrix unused{0, nullptr};
-    // Twice, as in two iterations of one solve: the second call reads the structure the first one cached.
+    // Outside a solve (structure copied for the call), then twice inside one, as in two iterations: the second
+    // call reads the structure the first one kept. The same numbers each time.
     op_o(k_, constraints_.data(), byblocks_.data(), zi, x, o.data(), unused, unused);
-    const std::vector<double> first = o;
-    op_o(k_, constraints_.data(), byblocks_.data(), zi, x, o.data(), unused, unused);
-    hw::sdp::ForgetSchurStructure();  // the end of the solve (csdp_backend.cpp)
-    EXPECT_EQ(o, first);
+    const std::vector<double> uncached = o;
+    {
+      const hw::sdp::CsdpSolveScope solve;
+      op_o(k_, constraints_.data(), byblocks_.data(), zi, x, o.data(), unused, unused);
+      EXPECT_EQ(o, uncached);
+      op_o(k_, constraints_.data(), byblocks_.data(), zi, x, o.data(), unused, unused);
+      EXPECT_EQ(o, uncached);
+    }
     MatrixXd out = MatrixXd::Zero(k_, k_);
     for (int j = 0; j < k_; ++j)
       for (int i = 0; i <= j; ++i) out(i, j) = o[static_cast<std::size_t>(j) * ld + i];
@@ -138,10 +143,14 @@ class RandomCsdpProblem {
   // A(X) from op_a(), called twice as in one solve (the second call reads the cached copy), against tr(A_i X).
   double WorstOpAError() {
     struct blockmatrix x{static_cast<int>(blocks_.size()), xrec_.data()};
-    std::vector<double> got(k_ + 1), again(k_ + 1);
+    std::vector<double> got(k_ + 1), first(k_ + 1), again(k_ + 1);
     op_a(k_, constraints_.data(), x, got.data());
-    op_a(k_, constraints_.data(), x, again.data());
-    hw::sdp::ForgetOperatorStructure();
+    {
+      const hw::sdp::CsdpSolveScope solve;
+      op_a(k_, constraints_.data(), x, first.data());
+      op_a(k_, constraints_.data(), x, again.data());
+    }
+    EXPECT_EQ(got, first);
     EXPECT_EQ(got, again);
     double worst = 0.0;
     for (int i = 1; i <= k_; ++i) {
@@ -167,8 +176,8 @@ class RandomCsdpProblem {
       rec[b + 1].blockcategory = blocks_[b].diagonal ? DIAG : MATRIX;
       rec[b + 1].data.mat = data.back().data();
     }
+    const hw::sdp::CsdpSolveScope solve;  // the call inside a solve (op_a above covers both paths)
     op_at(k_, y.data(), constraints_.data(), {static_cast<int>(blocks_.size()), rec.data()});
-    hw::sdp::ForgetOperatorStructure();
     double worst = 0.0;
     for (std::size_t b = 0; b < blocks_.size(); ++b) {
       const int n = blocks_[b].size;
