@@ -69,6 +69,7 @@ struct BoundsCliOptions {
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
   bool proper = false, no_cheap = false, no_edge_witnesses = false, no_full_pass_contraction = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
+  int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
   int row_block_order = -1;
 };
 
@@ -136,6 +137,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.edge_witness.enabled = !o.no_edge_witnesses;
   options.contract_before_full_pass = !o.no_full_pass_contraction;
   options.contraction_passes = o.contraction_passes;
+  options.stopped_short_refinements = o.stopped_short_refinements;
   options.generation.block_order_cap = o.row_block_order;
   options.parameters = o.params;
   options.generation.verify.enabled = !o.no_verify;
@@ -230,6 +232,9 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
   if (summary.jobs_stopped_beyond_witness > 0)
     fmt::print("{} relaxation job(s) ended early: their bound passed a certified feasible point's value, so further "
                "rounds could not move the endpoint\n", summary.jobs_stopped_beyond_witness);
+  if (summary.refine_jobs > 0)
+    fmt::print("{} endpoint job(s) solved again in a contracted box after a solve stopped short; {} bound(s) "
+               "tightened\n", summary.refine_jobs, summary.refine_tightened);
   if (summary.jobs_settled_by_sign > 0)
     fmt::print("{} relaxation job(s) not run: the orthant's sign constraints already bound them at or beyond a "
                "certified feasible point's value\n", summary.jobs_settled_by_sign);
@@ -336,6 +341,10 @@ void AddBoundsCommand(CLI::App& app) {
                 "bounds");
   cmd->add_option("--contract-passes", o->contraction_passes,
                   "cheap passes repeated in each orthant's contracted box, 0..10 (0 = no box contraction)");
+  cmd->add_option("--stopped-short-refinements", o->stopped_short_refinements,
+                  "times an endpoint resting on a solve that stopped short (partial success, pFEAS) is solved again "
+                  "in its orthant's box contracted to the verified bounds (0 = never)")
+      ->check(CLI::NonNegativeNumber);
   auto* verify = cmd->add_flag("--verify", o->verify,
                                "verify every bound and emptiness certificate rigorously in interval arithmetic "
                                "(the default)");

@@ -15,6 +15,7 @@
 #include "relax/edge_witness.hpp"
 #include "relax/full_pass.hpp"
 #include "relax/orthant_screen.hpp"
+#include "relax/refine_pass.hpp"
 #include "relax/row_reduction.hpp"
 #include "sdp/sdp_solver.hpp"
 
@@ -169,6 +170,7 @@ bool BoundsOptions::IsValid(std::string* error) const {
   if (order < 1 || order > kMaxOrder) return fail(fmt::format("order {} is out of range 1..{}", order, kMaxOrder));
   if (!ValidThreads(threads, error) || !ValidContractionPasses(contraction_passes, error)) return false;
   if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
+  if (stopped_short_refinements < 0) return fail("stopped_short_refinements must be >= 0");
   if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
   if (!ValidBoundsSolver(solver, error)) return false;
   if (!reduction.IsValid(error)) return false;
@@ -255,6 +257,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
   j["all_guaranteed"] = all_guaranteed();
   j["contraction_passes_run"] = contraction_passes_run;
+  j["stopped_short_refined"] = {{"jobs", refine_jobs}, {"tightened", refine_tightened}};
   j["row_reduction"] = row_reduction;
   j["bound_sources"] = bound_sources;
   j["clipped_to_prior_box"] = clipped_to_box;
@@ -343,7 +346,12 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   if (options.order > cheap_order)
     full = RunFullPass(FullPassOptions{options.order, cheap_order}, ctx, objectives, wanted_objectives, cheap_outcomes,
                        edges.settled, edges.witnessed, orthants);
-  // 6. Aggregate.
+  // 6. Solve again, in contracted boxes, the endpoints that rest on a solve that stopped short.
+  const RefinePassResult refined =
+      RefineStoppedShortEndpoints(RefinePassOptions{options.order, options.stopped_short_refinements}, ctx, objectives,
+                                  wanted_objectives, full, edges.witnessed, orthants);
+  full = refined.outcomes;
+  // 7. Aggregate.
   const AggregateResult agg = AggregateIntervals(
       AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,
       cheap_outcomes, full, orthants);
@@ -355,6 +363,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   AttachWitnessedRanges(set, summary.feasible_points, summary.intervals);
   summary.clipped_to_box = agg.clipped_to_box;
   summary.contraction_passes_run = cheap.contraction_passes_run;
+  summary.refine_jobs = refined.jobs_run;
+  summary.refine_tightened = refined.bounds_tightened;
   summary.order = options.order;
   summary.horizon = set.horizon();
   summary.solver = SolverForOrder(options.solver, options.order, options.generation.block_order_cap);

@@ -64,6 +64,10 @@ struct BoundsOptions {
   // data inequalities already gives a valid bound, and the prior box's ill-conditioned LMIs are kept small.
   // The last cheap pass always runs to the full relaxation (generation.max_rounds).
   int contraction_max_rounds = 4;
+  // After the last pass, an endpoint whose bound is the verified last iterate of a solve that stopped short (CSDP
+  // "partial success", SDPA pFEAS) is solved again in its orthant's box contracted to that pass's verified bounds,
+  // up to this many times (relax/refine_pass.hpp); the tighter bound is kept. 0 = off.
+  int stopped_short_refinements = 1;
   ConstraintGenerationOptions generation;  // its order is set per pass
   RowReductionOptions reduction;           // exact reduction of the data rows (stage 2)
   EdgeWitnessOptions edge_witness;         // endpoints settled by feasible points at the box edge (stage 3)
@@ -150,6 +154,8 @@ struct BoundsSummary {
   // Contracted box of every orthant left at the end (index, box), and the cheap passes run in contracted boxes.
   std::vector<std::pair<int, std::vector<std::pair<double, double>>>> orthant_boxes;
   int contraction_passes_run = 0;
+  // Endpoints solved again where a solve stopped short (BoundsOptions::stopped_short_refinements).
+  int refine_jobs = 0, refine_tightened = 0;
   // Exact row reduction per live orthant: {"orthant", "per_step": [{"step", "rows", "kept"}]}.
   std::vector<nlohmann::json> row_reduction;
   // Where the orthant bounds entering the endpoints came from (see relax/aggregate.hpp).

@@ -1,0 +1,105 @@
+#include "relax/refine_pass.hpp"
+
+#include <algorithm>
+#include <set>
+#include <string>
+
+#include "relax/box_contraction.hpp"
+#include "relax/row_reduction.hpp"
+
+namespace hw::relax {
+namespace {
+
+bool Beyond(int dir, double a, double b) { return dir < 0 ? a < b : a > b; }
+
+bool Usable(const JobOutcome& r) { return r.status == "solved" || r.status == "skipped"; }
+
+}  // namespace
+
+std::vector<std::pair<int, int>> StoppedShortEndpoints(const std::vector<Objective>& objectives,
+                                                       const std::vector<int>& wanted, const PassOutcomes& full,
+                                                       const std::vector<OrthantWork>& orthants) {
+  std::vector<std::pair<int, int>> out;
+  const std::set<int> wanted_set(wanted.begin(), wanted.end());
+  std::set<int> alive;
+  for (const auto& w : orthants)
+    if (!w.empty()) alive.insert(w.index);
+  for (const auto& [key, r] : full) {
+    const auto [l, o] = key;
+    if (!alive.count(l) || !wanted_set.count(o) || r.status != "solved" || !r.unfinished) continue;
+    const int dir = objectives[o].dir;
+    bool endpoint = true;
+    for (const auto& [other_key, other] : full)
+      if (other_key.second == o && other_key.first != l && alive.count(other_key.first) && Usable(other) &&
+          Beyond(dir, other.bound, r.bound))
+        endpoint = false;
+    if (endpoint) out.push_back(key);
+  }
+  return out;
+}
+
+RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, EngineContext& ctx,
+                                             const std::vector<Objective>& objectives,
+                                             const std::vector<int>& wanted, const PassOutcomes& full,
+                                             const std::map<int, double>& witnessed,
+                                             std::vector<OrthantWork>& orthants) {
+  RefinePassResult result;
+  result.outcomes = full;
+  std::map<int, std::size_t> position;  // orthant index -> position in `orthants`
+  for (std::size_t i = 0; i < orthants.size(); ++i) position[orthants[i].index] = i;
+  const bool verify_on = ctx.options.generation.verify.enabled;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    const auto targets = StoppedShortEndpoints(objectives, wanted, result.outcomes, orthants);
+    if (targets.empty()) break;
+    ++result.passes_run;
+    // The targets' orthants, contracted to this pass's verified bounds (copies until their rows are reduced).
+    std::set<int> target_orthants;
+    for (const auto& [l, o] : targets) target_orthants.insert(l);
+    std::vector<OrthantWork> next;
+    for (int l : target_orthants) next.push_back(orthants[position.at(l)]);
+    ContractOrthantBoxes(ctx, objectives, result.outcomes, next, options.order);
+    std::vector<OrthantWork> moved;  // live and in a smaller box: an unmoved box would repeat the same solves
+    for (const auto& w : next) {
+      OrthantWork& current = orthants[position.at(w.index)];
+      if (w.empty()) current.ProveEmpty(*w.certificate);  // verified bounds that cross
+      else if (w.box != current.box) moved.push_back(w);
+    }
+    if (moved.empty()) break;
+    ReduceOrthantRows(ctx, moved);
+    // Install the new boxes and rows; every outcome of those orthants keeps its working set as data rows.
+    for (const auto& w : moved) {
+      OrthantWork& current = orthants[position.at(w.index)];
+      for (auto& [key, r] : result.outcomes)
+        if (key.first == w.index) r.working_set = PositionsOfRows(w, RowsOfWorkingSet(current, r.working_set));
+      current = w;
+    }
+    std::vector<RelaxJob> jobs;
+    std::vector<std::pair<int, int>> job_key;
+    for (const auto& [l, o] : targets) {
+      const OrthantWork& w = orthants[position.at(l)];
+      if (w.empty() || std::none_of(moved.begin(), moved.end(), [&](const auto& m) { return m.index == l; })) continue;
+      jobs.push_back({&w, objectives[o], options.order, result.outcomes.at({l, o}).working_set, 0,
+                      StopBeyond(witnessed, o)});
+      job_key.push_back({l, o});
+    }
+    ctx.progress.Phase("order " + std::to_string(options.order) + " again where a solve stopped short",
+                       static_cast<int>(jobs.size()));
+    const auto outs = RunRelaxationJobs(ctx, jobs, orthants);
+    result.jobs_run += static_cast<int>(jobs.size());
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      JobOutcome& kept = result.outcomes.at(job_key[i]);
+      const JobOutcome& again = outs[i];
+      const int dir = objectives[job_key[i].second].dir;
+      // Infeasible: the orthant is empty (RunRelaxationJobs recorded the certificate). Solved: both bounds hold,
+      // the tighter one is kept.
+      const bool valid = again.status == "solved" && (!verify_on || again.verification == "verified");
+      if (again.status == "infeasible" || (valid && Beyond(-dir, again.bound, kept.bound))) {
+        kept = again;
+        ++result.bounds_tightened;
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace hw::relax

@@ -1,0 +1,88 @@
+// Endpoints resting on a solve that stopped short are solved again in a contracted box (relax/refine_pass.hpp):
+// which endpoints qualify, and on a seeded instance whose solves are cut short by an iteration limit, the refined
+// intervals lie inside the unrefined ones and still contain the truth.
+#include <gtest/gtest.h>
+
+#include "core/cerone_example.hpp"
+#include "relax/refine_pass.hpp"
+#include "relax/set_membership.hpp"
+#include "sdp/job_executor.hpp"
+
+namespace hw::relax {
+namespace {
+
+JobOutcome Solved(double bound, bool unfinished) {
+  JobOutcome r;
+  r.status = "solved";
+  r.bound = bound;
+  r.unfinished = unfinished;
+  return r;
+}
+
+TEST(RefinePass, OnlyStoppedShortBoundsThatAreTheEndpointQualify) {
+  const std::vector<Objective> objectives{{0, -1}, {0, +1}, {1, -1}};
+  std::vector<OrthantWork> orthants(4);
+  for (int l = 0; l < 4; ++l) orthants[l].index = l;
+  orthants[3].status = "empty (LP)";
+  PassOutcomes full;
+  // min x0: orthant 0 stopped short at -2 (the endpoint); orthant 1 stopped short at -1 (orthant 0 lies beyond).
+  full[{0, 0}] = Solved(-2.0, true);
+  full[{1, 0}] = Solved(-1.0, true);
+  full[{2, 0}] = Solved(-1.5, false);
+  full[{3, 0}] = Solved(-5.0, false);  // an empty orthant's outcome does not count
+  // max x0: the endpoint 3 is a finished bound; orthant 1's stopped-short 2.5 cannot move it.
+  full[{0, 1}] = Solved(3.0, false);
+  full[{1, 1}] = Solved(2.5, true);
+  full[{2, 1}] = Solved(1.0, false);
+  full[{3, 1}] = Solved(9.0, true);  // empty orthant: never a target
+  // min x1: not wanted.
+  full[{0, 2}] = Solved(-7.0, true);
+  full[{1, 2}] = Solved(-1.0, false);
+  full[{2, 2}] = Solved(-1.0, false);
+  full[{3, 2}] = Solved(-1.0, false);
+  const auto targets = StoppedShortEndpoints(objectives, {0, 1}, full, orthants);
+  ASSERT_EQ(targets.size(), 1u);
+  EXPECT_EQ(targets[0], std::make_pair(0, 0));
+  // A tie with a finished bound: the stopped-short one is still an endpoint (nothing lies beyond it).
+  full[{2, 0}] = Solved(-2.0, false);
+  EXPECT_EQ(StoppedShortEndpoints(objectives, {0, 1}, full, orthants).size(), 1u);
+}
+
+TEST(RefinePass, RefinedIntervalsLieInsideAndKeepTheTruth) {
+  const auto ex = SimulateCeroneExample(3, 60, 31.0);
+  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+  BoundsOptions options;
+  options.order = 1;
+  options.solver = "csdp";
+  options.retry_with_other_solver = false;
+  options.generation.sdp.max_iterations = 12;  // every solve stops short of optimal
+  options.executor = std::make_shared<sdp::InProcessExecutor>();
+  options.stopped_short_refinements = 0;
+  const auto plain = ComputeBounds(options, set);
+  options.stopped_short_refinements = 2;
+  const auto refined = ComputeBounds(options, set);
+  EXPECT_EQ(plain.refine_jobs, 0);
+  EXPECT_GT(refined.refine_jobs, 0) << "no endpoint stopped short: the test proves nothing";
+  EXPECT_GT(refined.refine_tightened, 0);
+  const auto truth = CeroneExample::TrueParameters();
+  ASSERT_EQ(plain.intervals.size(), refined.intervals.size());
+  int narrower = 0;
+  for (std::size_t k = 0; k < refined.intervals.size(); ++k) {
+    const auto& a = plain.intervals[k];
+    const auto& b = refined.intervals[k];
+    EXPECT_GE(b.lower.value, a.lower.value) << b.name;
+    EXPECT_LE(b.upper.value, a.upper.value) << b.name;
+    EXPECT_LE(b.lower.value, truth[k] + 1e-6) << b.name;
+    EXPECT_GE(b.upper.value, truth[k] - 1e-6) << b.name;
+    EXPECT_EQ(b.lower.verification, "verified") << b.name;
+    EXPECT_EQ(b.upper.verification, "verified") << b.name;
+    narrower += (b.upper.value - b.lower.value < a.upper.value - a.lower.value - 1e-9);
+  }
+  EXPECT_GT(narrower, 0);
+  std::printf("refine jobs %d, bounds tightened %d, narrower intervals %d\n", refined.refine_jobs,
+              refined.refine_tightened, narrower);
+}
+
+}  // namespace
+}  // namespace hw::relax
