@@ -1,15 +1,18 @@
 #include "compare/study.hpp"
 
+#include <sys/mman.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <new>
 #include <thread>
 
 #include <fmt/format.h>
@@ -195,6 +198,12 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
                scenario.name, options.runs, pending.size(), result.runs_resumed, jobs);
   std::vector<pid_t> children;
   if (!pending.empty()) {
+    // Runs go to whichever worker is free (a counter in memory the forked workers share): run times differ by
+    // 4x, and a fixed split left one worker with most of the slow runs. A run's result depends only on its
+    // index, never on the worker.
+    void* shared = mmap(nullptr, sizeof(std::atomic<int>), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (shared == MAP_FAILED) throw std::runtime_error("compare: mmap of the shared run counter failed");
+    auto* next_run = new (shared) std::atomic<int>(0);
     std::fflush(nullptr);
     const pid_t parent = getpid();
     for (int w = 0; w < jobs; ++w) {
@@ -203,7 +212,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
       if (pid == 0) {
         EndWithParent(parent);
         int code = 0;
-        for (std::size_t i = w; i < pending.size(); i += jobs) {
+        for (std::size_t i = next_run->fetch_add(1); i < pending.size(); i = next_run->fetch_add(1)) {
           const int r = pending[i];
           try {
             auto j = RunOne(scenario, options.methods, r, options.seed);
@@ -230,6 +239,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
       int status = 0;
       waitpid(pid, &status, 0);
     }
+    munmap(shared, sizeof(std::atomic<int>));
   }
   // Aggregate from the files only.
   std::vector<json> runs;
