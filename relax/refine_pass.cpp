@@ -1,6 +1,5 @@
 #include "relax/refine_pass.hpp"
 
-#include <algorithm>
 #include <set>
 #include <string>
 
@@ -73,11 +72,13 @@ RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, E
         if (key.first == w.index) r.working_set = PositionsOfRows(w, RowsOfWorkingSet(current, r.working_set));
       current = w;
     }
+    std::set<int> moved_index;
+    for (const auto& w : moved) moved_index.insert(w.index);
     std::vector<RelaxJob> jobs;
     std::vector<std::pair<int, int>> job_key;
     for (const auto& [l, o] : targets) {
       const OrthantWork& w = orthants[position.at(l)];
-      if (w.empty() || std::none_of(moved.begin(), moved.end(), [&](const auto& m) { return m.index == l; })) continue;
+      if (!moved_index.count(l)) continue;  // moved orthants are live
       jobs.push_back({&w, objectives[o], options.order, result.outcomes.at({l, o}).working_set, 0,
                       StopBeyond(witnessed, o)});
       job_key.push_back({l, o});
