@@ -245,8 +245,12 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
         steps += fmt::format("{}step {}: reduction failed ({}), every row of the orthant kept", steps.empty() ? "" : ", ",
                              c.value("step", 0), c.at("error").get<std::string>());
       else if (c.contains("step"))
-        steps += fmt::format("{}step {}: {} of {}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
-                             c.at("kept").get<int>(), c.at("rows").get<int>());
+        steps += fmt::format("{}step {}: {} of {}{}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
+                             c.at("kept").get<int>(), c.at("rows").get<int>(),
+                             c.value("iteration_limited", 0) > 0
+                                 ? fmt::format(" ({} kept after their LP hit the simplex iteration limit)",
+                                               c.at("iteration_limited").get<int>())
+                                 : std::string());
     fmt::print("exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);
   }
   if (!summary.bound_sources.empty()) {

@@ -23,7 +23,7 @@ struct GlpDeleter {
 // with g_i's own column (and the columns of rows already dropped) fixed at zero.
 class CombinationLp {
  public:
-  CombinationLp(const std::vector<const Polynomial*>& generators) : generators_(generators) {
+  CombinationLp(const std::vector<const Polynomial*>& generators, int iteration_limit) : generators_(generators) {
     for (const Polynomial* g : generators)
       for (const auto& [e, c] : g->terms()) monomial_.emplace(e, 0);
     int r = 1;
@@ -49,7 +49,13 @@ class CombinationLp {
     parm_.msg_lev = GLP_MSG_OFF;
     parm_.meth = GLP_PRIMAL;  // measured: the dual simplex is 50x slower on these zero-objective LPs
     parm_.presolve = GLP_OFF;
+    parm_.it_lim = iteration_limit;
   }
+
+  // LPs given up after the iteration limit (their rows are kept).
+  int iteration_limited() const { return iteration_limited_; }
+  // LPs that hit the limit from the warm basis and were solved again from the standard basis.
+  int restarts_after_limit() const { return restarts_after_limit_; }
 
   // Is generator `j` a nonnegative combination of the other active generators? (one LP)
   bool Implied(int j, double residual_tolerance) {
@@ -59,9 +65,14 @@ class CombinationLp {
     for (const auto& [e, c] : g.terms()) rhs[monomial_.at(e)] = c;
     for (int i = 1; i <= static_cast<int>(monomial_.size()); ++i) glp_set_row_bnds(lp_.get(), i, GLP_FX, rhs[i], rhs[i]);
     int rc = glp_simplex(lp_.get(), &parm_);
-    if (rc != 0) {  // the warm basis went bad (singular): start again from the standard basis
+    if (rc != 0) {  // the warm basis went bad (singular) or the simplex cycled: start again from the standard basis
       glp_std_basis(lp_.get());
+      if (rc == GLP_EITLIM) ++restarts_after_limit_;
       rc = glp_simplex(lp_.get(), &parm_);
+      if (rc == GLP_EITLIM) {
+        ++iteration_limited_;
+        glp_std_basis(lp_.get());  // the next row starts from a basis that has not cycled
+      }
     }
     const bool feasible = rc == 0 && glp_get_prim_stat(lp_.get()) == GLP_FEAS;
     bool implied = feasible && ResidualOk(rhs, residual_tolerance);
@@ -89,6 +100,8 @@ class CombinationLp {
   std::map<Exponents, int> monomial_;
   std::unique_ptr<glp_prob, GlpDeleter> lp_;
   glp_smcp parm_;
+  int iteration_limited_ = 0;
+  int restarts_after_limit_ = 0;
 };
 
 }  // namespace
@@ -96,6 +109,10 @@ class CombinationLp {
 bool RowReductionOptions::IsValid(std::string* error) const {
   if (!(residual_tolerance > 0 && residual_tolerance < 1e-3)) {
     if (error) *error = "row reduction residual_tolerance must lie in (0, 1e-3)";
+    return false;
+  }
+  if (simplex_iteration_limit < 1) {
+    if (error) *error = "row reduction simplex_iteration_limit must be positive";
     return false;
   }
   return true;
@@ -123,11 +140,13 @@ RowReductionResult ReduceDataRows(const RowReductionOptions& options, const std:
       for (const auto& f : fixed)
         if (ceil_half(f.degree()) <= key.second) generators.push_back(&f);
       generators.push_back(&one);
-      CombinationLp lp(generators);
+      CombinationLp lp(generators, options.simplex_iteration_limit);
       for (std::size_t k = 0; k < members.size(); ++k) {
         ++out.linear_programs;
         if (lp.Implied(static_cast<int>(k), options.residual_tolerance)) keep[members[k]] = 0;
       }
+      counts[key.first].iteration_limited += lp.iteration_limited();
+      out.restarts_after_limit += lp.restarts_after_limit();
     }
   }
   for (std::size_t i = 0; i < rows.size(); ++i)

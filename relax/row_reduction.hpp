@@ -24,12 +24,14 @@ struct RowGroupCount {
   int step = 0;       // horizon step s of the rows
   int rows = 0;       // rows before the reduction
   int kept = 0;       // rows kept
+  int iteration_limited = 0;  // rows kept because their LP hit the simplex iteration limit
 };
 
 struct RowReductionResult {
   std::vector<int> kept;                // indices into `rows`, ascending
   std::vector<RowGroupCount> per_step;  // ascending step
   int linear_programs = 0;
+  int restarts_after_limit = 0;         // LPs that cycled from the warm basis and were solved from the standard one
   double seconds = 0.0;
 };
 

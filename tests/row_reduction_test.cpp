@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "compare/methods.hpp"
+#include "compare/scenario.hpp"
 #include "relax/basis.hpp"
 #include "relax/bound_jobs.hpp"
 #include "relax/constraint_generation.hpp"
@@ -55,6 +57,55 @@ TEST(RowReduction, RowsOfAHigherLocalizingOrderAreNeverUsedForALowerOne) {
   const auto mixed = ReduceDataRows({}, {X(0) * X(0) + C(0.5), cubic + C(0.5)}, {1, 1}, {cubic});
   // The degree-2 row has no degree-2 generator but the constant; the cubic row = cubic + 0.5 is implied.
   EXPECT_EQ(mixed.kept, std::vector<int>{0});
+}
+
+TEST(RowReduction, ARowWhoseLpHitsTheIterationLimitIsKeptAndCounted) {
+  // r2 = r0 + 2 r1 + 0.2 needs at least one simplex pivot from the standard basis; with a limit of one iteration
+  // per attempt its LP stops short, so the row stays (always valid), and the count says why.
+  const std::vector<Polynomial> rows = {X(0) - C(0.1), X(1) - C(0.1), X(0) + X(1) * 2.0 + C(0.2)};
+  const std::vector<int> steps(rows.size(), 1);
+  RowReductionOptions limited;
+  limited.simplex_iteration_limit = 1;
+  const auto r = ReduceDataRows(limited, rows, steps, {});
+  ASSERT_EQ(r.per_step.size(), 1u);
+  EXPECT_EQ(r.kept.size(), 3u);
+  EXPECT_GE(r.per_step[0].iteration_limited, 1);
+  const auto free = ReduceDataRows({}, rows, steps, {});
+  EXPECT_EQ(free.kept.size(), 2u);
+  EXPECT_EQ(free.per_step[0].iteration_limited, 0);
+  limited.simplex_iteration_limit = 0;
+  std::string error;
+  EXPECT_FALSE(limited.IsValid(&error));
+}
+
+TEST(RowReduction, AnLpThatCyclesFromTheWarmBasisIsSolvedFromTheStandardOne) {
+  // Run 7 of `compare --scenario setmembership-example --seed 1` (record seed 8): in orthant 50, one step-2 LP
+  // cycled from the previous row's basis (GLPK's primal simplex, millions of iterations at zero objective and
+  // constant infeasibility), and the study's run never finished. With the iteration limit it is solved again from
+  // the standard basis and the reduction ends with the same kind of result as every other orthant.
+  const auto scenario = compare::LoadScenario("setmembership-example");
+  double bound = 0.0;
+  const auto rec = compare::RandomInputRecord(scenario.plant, scenario.input_lo, scenario.input_hi, 300, 31.0, 0.0,
+                                              8, &bound);
+  const auto cls = compare::SetMembershipTruth(scenario.plant);
+  const HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run 7"};
+  const HwOuterSet set(cls.structure, data, 2, std::vector<std::pair<double, double>>(cls.names.size(), {-10, 10}));
+  const int orthant = 50;
+  std::vector<Polynomial> rows;
+  std::vector<int> steps;
+  for (const auto& d : set.data_constraints(orthant))
+    if (d.s == 2) {
+      rows.push_back(d.g);
+      steps.push_back(d.s);
+    }
+  std::vector<Polynomial> fixed = set.box_constraints();
+  for (auto& g : set.sign_constraints(orthant)) fixed.push_back(g);
+  const auto r = ReduceDataRows({}, rows, steps, fixed);
+  EXPECT_GE(r.restarts_after_limit, 1);
+  ASSERT_EQ(r.per_step.size(), 1u);
+  EXPECT_EQ(r.per_step[0].iteration_limited, 0);
+  EXPECT_EQ(r.per_step[0].rows, 594);
+  EXPECT_LT(r.per_step[0].kept, 300);  // measured 203, as the neighbouring orthants' 175-292
 }
 
 // A random Hammerstein–Wiener instance: x = u + gamma2 u^2, z_t = -a1 z_{t-1} + b1 x_{t-1}, z = w + alpha2 w^2.
