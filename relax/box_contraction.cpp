@@ -48,24 +48,41 @@ double ContractOrthantBoxes(EngineContext& ctx, const std::vector<Objective>& ob
   return shrink;
 }
 
-PassOutcomes ContractBeforeFullPass(EngineContext& ctx, const std::vector<Objective>& objectives,
-                                    const PassOutcomes& cheap, std::vector<OrthantWork>& orthants, int cheap_order) {
+std::set<int> ContractAndReduceRows(EngineContext& ctx, const std::vector<Objective>& objectives,
+                                    PassOutcomes& outcomes, const std::set<int>& subset,
+                                    std::vector<OrthantWork>& orthants, int order) {
   std::map<int, std::size_t> position;  // orthant index -> position in `orthants`
   for (std::size_t i = 0; i < orthants.size(); ++i) position[orthants[i].index] = i;
-  // The cheap working sets as data-row indices, before the rows change.
-  std::map<std::pair<int, int>, std::vector<int>> working_rows;
-  for (const auto& [key, r] : cheap) working_rows[key] = RowsOfWorkingSet(orthants[position.at(key.first)], r.working_set);
-  std::vector<Box> before;
-  for (const auto& w : orthants) before.push_back(w.box);
-  ContractOrthantBoxes(ctx, objectives, cheap, orthants, cheap_order);
+  // Copies of the subset's live orthants, contracted; installed once their rows are reduced.
+  std::vector<OrthantWork> next;
+  for (int l : subset)
+    if (!orthants[position.at(l)].empty()) next.push_back(orthants[position.at(l)]);
+  ContractOrthantBoxes(ctx, objectives, outcomes, next, order);
   std::vector<OrthantWork> moved;
-  for (std::size_t i = 0; i < orthants.size(); ++i)
-    if (!orthants[i].empty() && orthants[i].box != before[i]) moved.push_back(orthants[i]);
-  ReduceOrthantRows(ctx, moved);
-  for (const auto& m : moved) orthants[position.at(m.index)] = m;
+  for (const auto& w : next) {
+    OrthantWork& current = orthants[position.at(w.index)];
+    if (w.empty()) current.ProveEmpty(*w.certificate);  // verified bounds that cross
+    else if (w.box != current.box) moved.push_back(w);
+  }
+  if (!moved.empty()) ReduceOrthantRows(ctx, moved);
+  std::set<int> moved_index;
+  for (const auto& w : moved) {
+    OrthantWork& current = orthants[position.at(w.index)];
+    for (auto& [key, r] : outcomes)  // each working set keeps its data rows, at their new positions
+      if (key.first == w.index) r.working_set = PositionsOfRows(w, RowsOfWorkingSet(current, r.working_set));
+    current = w;
+    moved_index.insert(w.index);
+  }
+  return moved_index;
+}
+
+PassOutcomes ContractBeforeFullPass(EngineContext& ctx, const std::vector<Objective>& objectives,
+                                    const PassOutcomes& cheap, std::vector<OrthantWork>& orthants, int cheap_order) {
+  std::set<int> live;
+  for (const auto& w : orthants)
+    if (!w.empty()) live.insert(w.index);
   PassOutcomes renumbered = cheap;
-  for (auto& [key, r] : renumbered)
-    if (const auto& w = orthants[position.at(key.first)]; !w.empty()) r.working_set = PositionsOfRows(w, working_rows[key]);
+  ContractAndReduceRows(ctx, objectives, renumbered, live, orthants, cheap_order);
   return renumbered;
 }
 

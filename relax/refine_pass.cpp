@@ -51,29 +51,13 @@ RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, E
     const auto targets = StoppedShortEndpoints(objectives, wanted, result.outcomes, orthants);
     if (targets.empty()) break;
     ++result.passes_run;
-    // The targets' orthants, contracted to this pass's verified bounds (copies until their rows are reduced).
+    // The targets' orthants, contracted to this pass's verified bounds, with their rows reduced again; an
+    // orthant whose box did not move would repeat the same solves.
     std::set<int> target_orthants;
     for (const auto& [l, o] : targets) target_orthants.insert(l);
-    std::vector<OrthantWork> next;
-    for (int l : target_orthants) next.push_back(orthants[position.at(l)]);
-    ContractOrthantBoxes(ctx, objectives, result.outcomes, next, options.order);
-    std::vector<OrthantWork> moved;  // live and in a smaller box: an unmoved box would repeat the same solves
-    for (const auto& w : next) {
-      OrthantWork& current = orthants[position.at(w.index)];
-      if (w.empty()) current.ProveEmpty(*w.certificate);  // verified bounds that cross
-      else if (w.box != current.box) moved.push_back(w);
-    }
-    if (moved.empty()) break;
-    ReduceOrthantRows(ctx, moved);
-    // Install the new boxes and rows; every outcome of those orthants keeps its working set as data rows.
-    for (const auto& w : moved) {
-      OrthantWork& current = orthants[position.at(w.index)];
-      for (auto& [key, r] : result.outcomes)
-        if (key.first == w.index) r.working_set = PositionsOfRows(w, RowsOfWorkingSet(current, r.working_set));
-      current = w;
-    }
-    std::set<int> moved_index;
-    for (const auto& w : moved) moved_index.insert(w.index);
+    const std::set<int> moved_index =
+        ContractAndReduceRows(ctx, objectives, result.outcomes, target_orthants, orthants, options.order);
+    if (moved_index.empty()) break;
     std::vector<RelaxJob> jobs;
     std::vector<std::pair<int, int>> job_key;
     for (const auto& [l, o] : targets) {
