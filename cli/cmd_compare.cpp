@@ -20,6 +20,7 @@ void AddCompareCommand(CLI::App& app) {
     int runs = 20, jobs = 2;
     std::uint64_t seed = 1;
     int sm_samples = 0, horizon = 0, order = 0, esm_samples = 0, esm_segments = 0, val_samples = 0, periods = 0;
+    int contract_passes = -1;
     double box = 0.0;
     bool no_plots = false, quiet = false;
   };
@@ -36,6 +37,10 @@ void AddCompareCommand(CLI::App& app) {
   cmd->add_option("--sm-samples", o->sm_samples, "override: set-membership record length N")->check(CLI::PositiveNumber)->default_str("the scenario's");
   cmd->add_option("--horizon", o->horizon, "override: set-membership horizon n")->check(CLI::PositiveNumber)->default_str("the scenario's");
   cmd->add_option("--order", o->order, "override: relaxation order delta")->check(CLI::PositiveNumber)->default_str("the scenario's");
+  cmd->add_option("--contract-passes", o->contract_passes,
+                  "override: set-membership cheap passes repeated in each orthant's contracted box (0..10)")
+      ->check(CLI::Range(0, 10))
+      ->default_str("the scenario's");
   cmd->add_option("--params", o->params, "override: only these intervals (no point estimate then)")
       ->delimiter(',')
       ->default_str("the scenario's");
@@ -52,6 +57,7 @@ void AddCompareCommand(CLI::App& app) {
     if (o->sm_samples > 0) s.setmembership.samples = o->sm_samples;
     if (o->horizon > 0) s.setmembership.horizon = o->horizon;
     if (o->order > 0) s.setmembership.order = o->order;
+    if (o->contract_passes >= 0) s.setmembership.contract_passes = o->contract_passes;
     if (!o->params.empty()) s.setmembership.parameters = o->params;
     if (o->box > 0) {
       s.setmembership.box.clear();

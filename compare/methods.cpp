@@ -131,6 +131,7 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
   o.order = sm.order;
   o.solver = sm.solver;
   o.parameters = sm.parameters;
+  o.contraction_passes = sm.contract_passes;
   // Runs are already spread over worker processes; each run solves in its own process, sequentially.
   o.executor = std::make_shared<sdp::InProcessExecutor>();
   std::string err;

@@ -94,6 +94,8 @@ bool Scenario::IsValid(std::string* error) const {
   if (!relax::ValidHorizon(sm.horizon, &e) || !relax::ValidOrder(sm.order, sm.horizon, &e) ||
       !relax::ValidBoundsSolver(sm.solver, &e))
     return fail("setmembership: " + e);
+  if (sm.contract_passes < 0 || sm.contract_passes > 10)
+    return fail(fmt::format("setmembership: contract_passes is {}; it must lie in 0..10", sm.contract_passes));
   const auto& es = esmaeilani;
   if (es.segments < 1 || es.samples < 20 || es.hold_min < 1 || es.hold_max < es.hold_min || es.grid_f < 2 ||
       es.grid_g < 2 || es.max_iterations < 1)
@@ -121,7 +123,8 @@ nlohmann::json Scenario::to_json() const {
   }
   const auto& sm = setmembership;
   j["setmembership"] = {{"samples", sm.samples}, {"horizon", sm.horizon}, {"order", sm.order},
-                        {"parameters", sm.parameters}, {"solver", sm.solver}};
+                        {"parameters", sm.parameters}, {"solver", sm.solver},
+                        {"contract_passes", sm.contract_passes}};
   if (sm.box.empty()) j["setmembership"]["box"] = sm.box_half_width;
   else j["setmembership"]["box"] = sm.box;
   const auto& es = esmaeilani;
@@ -201,12 +204,13 @@ Scenario Scenario::FromJson(const nlohmann::json& j, const std::string& source) 
     if (j.contains("setmembership")) {
       const auto& m = j.at("setmembership");
       const std::string w = source + ": setmembership";
-      CheckKeys(m, {"samples", "horizon", "order", "parameters", "box", "solver"}, w);
+      CheckKeys(m, {"samples", "horizon", "order", "parameters", "box", "solver", "contract_passes"}, w);
       auto& sm = s.setmembership;
       sm.samples = m.value("samples", sm.samples);
       sm.horizon = m.value("horizon", sm.horizon);
       sm.order = m.value("order", sm.order);
       sm.solver = m.value("solver", sm.solver);
+      sm.contract_passes = m.value("contract_passes", sm.contract_passes);
       if (m.contains("parameters")) sm.parameters = m.at("parameters").get<std::vector<std::string>>();
       if (m.contains("box")) {
         if (m.at("box").is_number()) sm.box_half_width = m.at("box").get<double>();

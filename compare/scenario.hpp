@@ -41,6 +41,8 @@ struct SetMembershipExperiment {
   std::vector<std::pair<double, double>> box;  // prior box; empty = +-box_half_width
   double box_half_width = 10.0;
   std::string solver = "auto";
+  // Cheap passes repeated in each orthant's contracted box (BoundsOptions::contraction_passes, 0..10).
+  int contract_passes = 0;
 };
 struct EsmaeilaniExperiment {
   int segments = 2;

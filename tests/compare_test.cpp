@@ -109,7 +109,17 @@ TEST(CompareScenario, BadScenarioFilesAreClearErrors) {
   expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "noise": {"std": 1}})", "bounded");
   expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "setmembership": {"horizon": 3}})",
                "minimal order");
+  expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "setmembership": {"contract_passes": 11}})",
+               "contract_passes is 11; it must lie in 0..10");
   expect_error("{not json", "not valid JSON");
+  {  // contract_passes reaches the scenario and its record (scenario.json decides whether a study resumes)
+    const std::string path = dir + "/contract.json";
+    std::ofstream(path) << R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "noise": {"bound": 0.1},
+                                "setmembership": {"contract_passes": 2}})";
+    const auto s = LoadScenario(path);
+    EXPECT_EQ(s.setmembership.contract_passes, 2);
+    EXPECT_EQ(s.to_json()["setmembership"]["contract_passes"], 2);
+  }
   EXPECT_THROW(LoadScenario(dir + "/missing.json"), InputError);
   // The truth outside the prior box is an assumption violation, reported as a failed run with the reason.
   auto s = LoadScenario("setmembership-example");
