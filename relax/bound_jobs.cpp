@@ -269,8 +269,9 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
       std::vector<int> kept;  // indices into all_rows
       for (int k : r.kept) kept.push_back(index[k]);
       nlohmann::json counts = nlohmann::json::array();
-      for (const auto& c : r.per_step) 
-        counts.push_back({{"step", c.step}, {"rows", c.rows}, {"kept", c.kept}, {"iteration_limited", c.iteration_limited}});
+      for (const auto& c : r.per_step)
+        counts.push_back(
+            {{"step", c.step}, {"rows", c.rows}, {"kept", c.kept}, {"iteration_limited", c.iteration_limited}});
       return nlohmann::json{{"kept", kept}, {"per_step", counts}, {"linear_programs", r.linear_programs},
                             {"seconds", r.seconds}}
           .dump();

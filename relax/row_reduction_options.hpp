@@ -2,7 +2,6 @@
 // Options of the exact row reduction (relax/row_reduction.hpp), apart so that BoundsOptions can hold them.
 #include <string>
 
-
 namespace hw::relax {
 
 struct RowReductionOptions {
