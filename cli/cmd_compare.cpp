@@ -39,7 +39,7 @@ void AddCompareCommand(CLI::App& app) {
   cmd->add_option("--order", o->order, "override: relaxation order delta")->check(CLI::PositiveNumber)->default_str("the scenario's");
   cmd->add_option("--contract-passes", o->contract_passes,
                   "override: set-membership cheap passes repeated in each orthant's contracted box (0..10)")
-      ->check(CLI::Range(0, 10))
+      ->check(CLI::NonNegativeNumber)
       ->default_str("the scenario's");
   cmd->add_option("--params", o->params, "override: only these intervals (no point estimate then)")
       ->delimiter(',')

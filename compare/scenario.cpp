@@ -92,10 +92,8 @@ bool Scenario::IsValid(std::string* error) const {
   if (sm.samples < 10 || !(sm.box_half_width > 0)) return fail("setmembership: samples >= 10, box > 0");
   std::string e;  // the bounds command's checks, with its messages
   if (!relax::ValidHorizon(sm.horizon, &e) || !relax::ValidOrder(sm.order, sm.horizon, &e) ||
-      !relax::ValidBoundsSolver(sm.solver, &e))
+      !relax::ValidBoundsSolver(sm.solver, &e) || !relax::ValidContractionPasses(sm.contract_passes, &e))
     return fail("setmembership: " + e);
-  if (sm.contract_passes < 0 || sm.contract_passes > 10)
-    return fail(fmt::format("setmembership: contract_passes is {}; it must lie in 0..10", sm.contract_passes));
   const auto& es = esmaeilani;
   if (es.segments < 1 || es.samples < 20 || es.hold_min < 1 || es.hold_max < es.hold_min || es.grid_f < 2 ||
       es.grid_g < 2 || es.max_iterations < 1)

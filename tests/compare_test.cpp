@@ -110,7 +110,7 @@ TEST(CompareScenario, BadScenarioFilesAreClearErrors) {
   expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "setmembership": {"horizon": 3}})",
                "minimal order");
   expect_error(R"({"name": "x", "model": {"linear": {"a": [0.5], "b": [0, 1]}}, "setmembership": {"contract_passes": 11}})",
-               "contract_passes is 11; it must lie in 0..10");
+               "contraction_passes 11 is out of range 0..10");
   expect_error("{not json", "not valid JSON");
   {  // contract_passes reaches the scenario and its record (scenario.json decides whether a study resumes)
     const std::string path = dir + "/contract.json";
