@@ -67,7 +67,7 @@ struct BoundsCliOptions {
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
-  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_full_pass_contraction = false, quiet = false, verify = false, no_verify = false;
+  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
   int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
   int row_block_order = -1;
@@ -136,6 +136,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.cheap_pass = !o.no_cheap;
   options.edge_witness.enabled = !o.no_edge_witnesses;
   options.contract_before_full_pass = !o.no_full_pass_contraction;
+  options.retry_with_other_solver = o.solver_retry;
   options.contraction_passes = o.contraction_passes;
   options.stopped_short_refinements = o.stopped_short_refinements;
   options.generation.block_order_cap = o.row_block_order;
@@ -340,6 +341,10 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--row-block-order", o->row_block_order,
                   "localizing order of the data rows' blocks at most (-1: full order; 1 at order 3: 9x9 blocks, a "
                   "mixed relaxation between orders 2 and 3, valid and cheaper)");
+  cmd->add_flag("--solver-retry", o->solver_retry,
+                "solve a constraint-generation round the backend leaves undecided (partial success, pFEAS) again with "
+                "the other backend before taking its verified last iterate (off: measured to cost time, not "
+                "tightness, docs/setmembership_scale.md)");
   cmd->add_flag("--no-full-pass-contraction", o->no_full_pass_contraction,
                 "run the order-delta jobs in the prior box, not in each orthant's box contracted to its cheap-order "
                 "bounds");

@@ -284,6 +284,7 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     ConstraintGenerationOptions gen = gen_options;
     gen.order = spec.at("d");
     if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
+    gen.retry_undecided_rounds = options.retry_with_other_solver;
     if (spec.contains("stop_beyond")) {  // original units -> this box's scaled units
       const auto& scaling = set.scaling();
       gen.stop_beyond = (spec.at("stop_beyond").get<double>() - scaling.center[obj.param]) / scaling.radius[obj.param];
@@ -307,7 +308,7 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
                                     r.violated < 0 ? std::string("-") : std::to_string(r.violated), bound));
     };
     const auto r = SolveWithConstraintGeneration(gen, core, candidates, spec.at("initial").get<std::vector<int>>(),
-                                                 *solver, on_round, options.retry_with_other_solver ? other.get() : nullptr);
+                                                 *solver, on_round, other.get());
     JobOutcome out;
     out.rounds = r.rounds;
     out.sdp_iterations = r.sdp_iterations;

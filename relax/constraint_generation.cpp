@@ -217,7 +217,7 @@ ConstraintGenerationResult SolveWithConstraintGeneration(const ConstraintGenerat
     if (options.warm_start && warm_y.size() == relaxation.lmi().c.size()) round_options.initial_y = warm_y;
     auto sdp = solver.Solve(round_options, relaxation.lmi());
     sdp::SdpSolver* used = &solver;
-    if (fallback && !sdp.decided()) {
+    if (fallback && options.retry_undecided_rounds && !sdp.decided()) {
       const std::string first = sdp.message;
       result.solve_seconds += sdp.setup_seconds + sdp.solve_seconds;
       auto second = fallback->Solve(sdp_options, relaxation.lmi());

@@ -33,6 +33,12 @@ struct ConstraintGenerationOptions {
   // order min(full, block_order_cap); -1 = full order. Any cap relaxes the full order-delta relaxation, so the
   // bound stays valid; "tight" then means equal to the capped relaxation over every candidate.
   int block_order_cap = -1;
+  // A round the backend leaves undecided (CSDP partial success, SDPA pFEAS) is solved again by the `fallback`
+  // backend before its verified last iterate is taken. Off by default: on 300-sample records of the paper's example
+  // at 31 dB the second backend stopped short as well, on every such round, and the retries took half of the SDP
+  // time (docs/setmembership_scale.md, "Retrying undecided rounds"). The fallback still gets its chance at an
+  // emptiness certificate that does not verify.
+  bool retry_undecided_rounds = false;
   // Pass the previous round's moments to backends that take an initial point (SdpOptions::initial_y).
   bool warm_start = true;
   double active_fraction = 1e-4;  // see ConstraintGenerationResult::active_set
@@ -106,8 +112,9 @@ struct ConstraintGenerationResult {
 
 // `core` inequalities are always in the LMI with full blocks; `candidates` get blocks on demand, starting
 // from `initial`. `on_round` (optional) sees each round as it ends (progress lines). When the solver fails on a
-// round's LMI (neither optimal nor a certified infeasible/unbounded outcome), `fallback` (optional, e.g. the
-// other backend) solves the same LMI before the round counts as failed. A failed round ends the job with the
+// round's LMI (neither optimal nor a certified infeasible/unbounded outcome) and options.retry_undecided_rounds is
+// set, `fallback` (optional, e.g. the other backend) solves the same LMI before the round counts as failed; an
+// infeasibility certificate that does not verify always gets the fallback's. A failed round ends the job with the
 // best verified bound of all its rounds (its own last iterate included).
 ConstraintGenerationResult SolveWithConstraintGeneration(
     const ConstraintGenerationOptions& options, const PolyProblem& core, const std::vector<Polynomial>& candidates,

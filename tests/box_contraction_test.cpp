@@ -118,6 +118,44 @@ TEST(ConstraintGeneration, ASolveThatStopsShortStillGivesAVerifiedBound) {
   EXPECT_EQ(SolveWithConstraintGeneration(o, core, candidates, {}, short_solver).status, RelaxationStatus::kSolverFailed);
 }
 
+// CSDP that counts its solves: the other backend of a job.
+class CountingSolver : public sdp::SdpSolver {
+ public:
+  std::string name() const override { return "counting-csdp"; }
+  sdp::SdpSummary Solve(const sdp::SdpOptions& options, const sdp::LmiProblem& problem) override {
+    ++calls;
+    return inner_->Solve(options, problem);
+  }
+  int calls = 0;
+
+ private:
+  std::unique_ptr<sdp::SdpSolver> inner_ = sdp::MakeSolver("csdp");
+};
+
+TEST(ConstraintGeneration, AnUndecidedRoundGoesToTheOtherBackendOnlyWhenAsked) {
+  ConstraintGenerationOptions o;
+  o.order = 2;
+  const auto x1 = Polynomial::Variable(2, 0), x2 = Polynomial::Variable(2, 1);
+  std::vector<Polynomial> candidates = {Polynomial::Constant(2, 0.5) - x1 * x1 - x2 * x2};
+  StopsShort short_solver;
+  // Default: the round that stopped short keeps its verified last iterate; the other backend is not asked.
+  CountingSolver other;
+  const auto kept = SolveWithConstraintGeneration(o, Core(), candidates, {}, short_solver, {}, &other);
+  ASSERT_EQ(kept.status, RelaxationStatus::kSolved) << kept.message;
+  EXPECT_EQ(other.calls, 0);
+  EXPECT_TRUE(kept.bound_from_unfinished_solve);
+  EXPECT_LE(kept.bound, -std::sqrt(0.5) + 1e-9);
+  // Asked for: the other backend solves the same LMI, and its converged round gives the bound.
+  o.retry_undecided_rounds = true;
+  CountingSolver retry;
+  const auto retried = SolveWithConstraintGeneration(o, Core(), candidates, {}, short_solver, {}, &retry);
+  ASSERT_EQ(retried.status, RelaxationStatus::kSolved) << retried.message;
+  EXPECT_GE(retry.calls, 1);
+  EXPECT_FALSE(retried.bound_from_unfinished_solve);
+  EXPECT_NEAR(retried.bound, -std::sqrt(0.5), 1e-5);
+  EXPECT_LE(retried.bound, -std::sqrt(0.5) + 1e-9);
+}
+
 TEST(LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
   auto solver = sdp::MakeSolver("csdp");
   // x1 >= 0.5 and x1 + x2 <= 0.2 inside [-1, 1]^2: x1 in [0.5, 1], x2 <= -0.3.
