@@ -42,8 +42,10 @@ relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuter
     const bool phase_end = p.done >= p.total;
     if (p.done <= 0 || !throttle.Due(p.elapsed_seconds, phase_end)) return;
     if (phase_end) throttle.Reset();  // the next phase's clock starts at 0
-    log(fmt::format("  [{}] {} of {} jobs, {:.0f} s{}", p.phase, p.done, p.total, p.elapsed_seconds,
-                    p.done < p.total ? fmt::format(", about {:.0f} s left", p.eta_seconds) : ""));
+    // done / total count the jobs still to run; those read back from the run cache are named apart.
+    log(fmt::format("  [{}] {} of {} jobs{}, {:.0f} s{}", p.phase, p.done, p.total,
+                    p.from_cache > 0 ? fmt::format(" (and {} read from the run cache)", p.from_cache) : "",
+                    p.elapsed_seconds, p.done < p.total ? fmt::format(", about {:.0f} s left", p.eta_seconds) : ""));
   });
   log(fmt::format("{}: order {} done in {:.1f} s", c.label(), order, summary.wall_seconds));
   return summary;
