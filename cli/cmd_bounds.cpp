@@ -136,7 +136,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.cheap_pass = !o.no_cheap;
   options.edge_witness.enabled = !o.no_edge_witnesses;
   options.contract_before_full_pass = !o.no_full_pass_contraction;
-  options.retry_with_other_solver = o.solver_retry;
+  options.generation.retry_undecided_rounds = o.solver_retry;
   options.contraction_passes = o.contraction_passes;
   options.stopped_short_refinements = o.stopped_short_refinements;
   options.generation.block_order_cap = o.row_block_order;

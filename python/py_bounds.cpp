@@ -159,7 +159,7 @@ void DefineBounds(py::module_& m) {
         op.cheap_pass = cheap_pass;
         op.edge_witness.enabled = edge_witnesses;
         op.lp_screen = lp_screen;
-        op.retry_with_other_solver = retry_with_other_solver;
+        op.generation.retry_undecided_rounds = retry_with_other_solver;
         op.contract_before_full_pass = full_pass_contraction;
         op.contraction_passes = contraction_passes;
         op.contraction_min_shrink = contraction_min_shrink;
@@ -186,7 +186,7 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
       py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,
       py::arg("lp_screen") = o.lp_screen,
-      py::arg("retry_with_other_solver") = o.retry_with_other_solver,
+      py::arg("retry_with_other_solver") = o.generation.retry_undecided_rounds,
       py::arg("full_pass_contraction") = o.contract_before_full_pass,
       py::arg("contraction_passes") = o.contraction_passes,
       py::arg("contraction_min_shrink") = o.contraction_min_shrink,

@@ -284,7 +284,6 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     ConstraintGenerationOptions gen = gen_options;
     gen.order = spec.at("d");
     if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
-    gen.retry_undecided_rounds = options.retry_with_other_solver;
     if (spec.contains("stop_beyond")) {  // original units -> this box's scaled units
       const auto& scaling = set.scaling();
       gen.stop_beyond = (spec.at("stop_beyond").get<double>() - scaling.center[obj.param]) / scaling.radius[obj.param];

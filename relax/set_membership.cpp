@@ -78,7 +78,7 @@ std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nloh
            {"gap_tolerance", options.generation.sdp.gap_tolerance}, {"verify", options.generation.verify.enabled},
            {"linear_rows_first", options.generation.linear_rows_first},
            {"add_per_round", options.generation.add_per_round}, {"max_rounds", options.generation.max_rounds},
-           {"retry_undecided_rounds", options.retry_with_other_solver},
+           {"retry_undecided_rounds", options.generation.retry_undecided_rounds},
            {"row_reduction", options.reduction.enabled},
            {"contraction_passes", options.contraction_passes},
            {"contraction_min_shrink", options.contraction_min_shrink},

@@ -37,9 +37,6 @@ struct BoundsOptions {
   bool lp_screen = true;
   // "auto" (the backend per relaxation, SolverForOrder), "csdp", "sdpa" or "dsdp".
   std::string solver = "auto";
-  // A round the backend leaves undecided is solved again with the other backend (CSDP <-> SDPA; DSDP -> CSDP)
-  // before its verified last iterate is taken (ConstraintGenerationOptions::retry_undecided_rounds: off, measured).
-  bool retry_with_other_solver = false;
   // Local parallel jobs. CSDP and SDPA are not thread-safe, so jobs run in forked worker processes
   // (sdp::ForkExecutor); 0 = one per core. Ignored when `executor` is set.
   int threads = 0;

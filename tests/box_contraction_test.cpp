@@ -201,7 +201,7 @@ BoundsSummary RunSmall(int contraction_passes) {
   options.order = 2;
   options.solver = "csdp";
   options.threads = 2;
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   options.contraction_passes = contraction_passes;
   options.contraction_max_rounds = 2;
   return ComputeBounds(options, SmallSet(40));
@@ -257,7 +257,7 @@ TEST(BoxContraction, TheFullPassRunsInTheBoxesOfTheCheapBounds) {
   options.order = 3;
   options.solver = "csdp";
   options.threads = 2;
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   const HwOuterSet set = SmallSet(40);
   const auto contracted = ComputeBounds(options, set);
   options.contract_before_full_pass = false;

@@ -335,7 +335,7 @@ TEST(DsdpBackend, SetMembershipEngineRunsWithDsdp) {
   relax::HwOuterSet set(relax::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10, 10}));
   options.order = 1;
   options.threads = 2;
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   const auto d = relax::ComputeBounds(options, set);
   options.solver = "csdp";
   const auto c = relax::ComputeBounds(options, set);

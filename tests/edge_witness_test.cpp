@@ -35,7 +35,7 @@ TEST(EdgeWitness, SettledEndpointsEqualTheRelaxationsAndContainTheTruth) {
   BoundsOptions options;
   options.order = 2;
   options.threads = 2;
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   options.parameters = {"gamma2", "alpha3"};
   const BoundsSummary with = ComputeBounds(options, set);
   options.edge_witness.enabled = false;

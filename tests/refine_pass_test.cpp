@@ -55,7 +55,7 @@ TEST(RefinePass, RefinedIntervalsLieInsideAndKeepTheTruth) {
   BoundsOptions options;
   options.order = 1;
   options.solver = "csdp";
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   options.generation.sdp.max_iterations = 12;  // every solve stops short of optimal
   options.executor = std::make_shared<sdp::InProcessExecutor>();
   options.stopped_short_refinements = 0;

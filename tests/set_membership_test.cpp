@@ -25,7 +25,7 @@ BoundsSummary RunBounds(uint64_t seed, int samples, int horizon, int order, doub
   options.parameters = params;
   // Retrying failed rounds with the other backend can multiply a test's run time; the CI tests keep the
   // single-backend configuration whose run time was measured (about 5 minutes for the n = 2 test).
-  options.retry_with_other_solver = retry;
+  options.generation.retry_undecided_rounds = retry;
   return ComputeBounds(options, set);
 }
 
@@ -79,7 +79,7 @@ TEST(SetMembership, SameEndpointsWhateverTheNumberOfWorkers) {
   HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
   BoundsOptions options;
   options.order = 1;
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   options.executor = std::make_shared<sdp::ForkExecutor>(1);
   const auto one = ComputeBounds(options, set);
   options.executor = std::make_shared<sdp::ForkExecutor>(2);

@@ -299,7 +299,7 @@ TEST(VerifiedBound, EverySetMembershipEndpointCarriesItsVerification) {
   relax::BoundsOptions options;
   options.order = 1;
   options.threads = 2;
-  options.retry_with_other_solver = false;
+  options.generation.retry_undecided_rounds = false;
   const auto s = relax::ComputeBounds(options, set);
   const auto truth = CeroneExample::TrueParameters();
   ASSERT_FALSE(s.intervals.empty());
