@@ -67,7 +67,7 @@ struct BoundsCliOptions {
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
-  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verify = false, no_verify = false;
+  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_moment_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
   int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
   int row_block_order = -1;
@@ -135,6 +135,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.run_dir = o.run_dir;
   options.cheap_pass = !o.no_cheap;
   options.edge_witness.enabled = !o.no_edge_witnesses;
+  options.moment_witnesses = !o.no_moment_witnesses;
   options.contract_before_full_pass = !o.no_full_pass_contraction;
   options.generation.retry_undecided_rounds = o.solver_retry;
   options.contraction_passes = o.contraction_passes;
@@ -230,6 +231,9 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
   if (summary.edge_witness_solves > 0)
     fmt::print("feasible points at the box edges: {} endpoint(s) settled without an SDP ({} local solves, {:.1f} s)\n",
                summary.edge_witness_settled, summary.edge_witness_solves, summary.edge_witness_seconds);
+  if (summary.moment_witness_jobs > 0)
+    fmt::print("feasible points from the relaxations' moments: {} of {} local searches certified ({:.1f} s)\n",
+               summary.moment_witness_found, summary.moment_witness_jobs, summary.moment_witness_seconds);
   if (summary.jobs_stopped_beyond_witness > 0)
     fmt::print("{} relaxation job(s) ended early: their bound passed a certified feasible point's value, so further "
                "rounds could not move the endpoint\n", summary.jobs_stopped_beyond_witness);
@@ -338,6 +342,9 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_flag("--no-cheap-pass", o->no_cheap, "solve every orthant at full order (no minimal-order screening)");
   cmd->add_flag("--no-edge-witnesses", o->no_edge_witnesses,
                 "solve every endpoint by SDP, also those a feasible point at the prior box edge settles");
+  cmd->add_flag("--no-moment-witnesses", o->no_moment_witnesses,
+                "skip the local searches from the relaxations' first moments (they only widen the \"feasible "
+                "points reach\" ranges)");
   cmd->add_option("--row-block-order", o->row_block_order,
                   "localizing order of the data rows' blocks at most (-1: full order; 1 at order 3: 9x9 blocks, a "
                   "mixed relaxation between orders 2 and 3, valid and cheaper)");

@@ -136,7 +136,7 @@ void DefineBounds(py::module_& m) {
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
          std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
-         bool edge_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
+         bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink,
          int contraction_max_rounds, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
          py::object progress, std::string source) {
@@ -158,6 +158,7 @@ void DefineBounds(py::module_& m) {
         op.parameters = std::move(parameters);
         op.cheap_pass = cheap_pass;
         op.edge_witness.enabled = edge_witnesses;
+        op.moment_witnesses = moment_witnesses;
         op.lp_screen = lp_screen;
         op.generation.retry_undecided_rounds = retry_with_other_solver;
         op.contract_before_full_pass = full_pass_contraction;
@@ -185,6 +186,7 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("box") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
       py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
       py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,
+      py::arg("moment_witnesses") = o.moment_witnesses,
       py::arg("lp_screen") = o.lp_screen,
       py::arg("retry_with_other_solver") = o.generation.retry_undecided_rounds,
       py::arg("full_pass_contraction") = o.contract_before_full_pass,

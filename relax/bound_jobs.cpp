@@ -55,7 +55,7 @@ nlohmann::json JobOutcome::to_json() const {
           {"working_set", working_set}, {"active_set", active_set}, {"verification", verification}, {"float_bound", float_bound},
           {"correction", correction}, {"verify_seconds", verify_seconds}, {"origin", origin},
           {"bound_round", bound_round}, {"unfinished", unfinished},
-          {"beyond_known_value", beyond_known_value}};
+          {"beyond_known_value", beyond_known_value}, {"first_moments", first_moments}};
 }
 
 JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
@@ -79,6 +79,7 @@ JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
   o.bound_round = j.at("bound_round");
   o.unfinished = j.at("unfinished");
   o.beyond_known_value = j.value("beyond_known_value", false);
+  if (j.contains("first_moments")) o.first_moments = j.at("first_moments").get<std::vector<double>>();
   return o;
 }
 
@@ -175,9 +176,9 @@ void ProgressReporter::Message(const std::string& text) {
   if (sink_) sink_({text, -1, -1, 0, 0.0, 0.0});
 }
 
-std::string BoxHash(const Box& box) {
-  return fmt::format("{:016x}", fnv(1469598103934665603ull, nlohmann::json(box).dump()));
-}
+std::string BoxHash(const Box& box) { return TextHash(nlohmann::json(box).dump()); }
+
+std::string TextHash(const std::string& text) { return fmt::format("{:016x}", fnv(1469598103934665603ull, text)); }
 
 PolyProblem OrthantObjectiveCore(const HwOuterSet& set, int l, const Objective& objective) {
   PolyProblem core;
@@ -324,6 +325,8 @@ sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet&
     out.origin = ToString(r.origin);
     out.bound_round = r.bound_round;
     out.unfinished = r.bound_from_unfinished_solve;
+    for (std::size_t i = 0; i < r.first_moments.size(); ++i)
+      out.first_moments.push_back(set.scaling().to_original(static_cast<int>(i), r.first_moments[i]));
     if (r.status == RelaxationStatus::kInfeasible) {
       out.status = "infeasible";
     } else if (r.status == RelaxationStatus::kSolved) {

@@ -59,6 +59,9 @@ struct JobOutcome {
   int bound_round = 0;
   bool unfinished = false;         // the bound is the verified last iterate of a solve that stopped short
   bool beyond_known_value = false; // ended once its bound passed stop_beyond: valid, cannot move the endpoint
+  // The last solved round's first-order moments, original units (empty when no round solved): the relaxation's
+  // guess of the extreme point, a start for a local search of a feasible point there (relax/moment_witness.hpp).
+  std::vector<double> first_moments;
   nlohmann::json to_json() const;
   static JobOutcome from_json(const nlohmann::json& j);
 };
@@ -179,5 +182,7 @@ std::vector<int> RowsOfWorkingSet(const OrthantWork& orthant, const std::vector<
 
 // A short hash of a box (cache keys of jobs in contracted boxes).
 std::string BoxHash(const Box& box);
+// A short hash of a text (cache keys of jobs named by their inputs).
+std::string TextHash(const std::string& text);
 
 }  // namespace hw::relax

@@ -128,15 +128,12 @@ std::vector<FeasiblePoint> ExtremeFeasiblePoints(const std::vector<Objective>& o
   return extreme;
 }
 
-namespace {
-
 std::string WitnessSpec(const OrthantWork& w, const Objective& o, const std::vector<std::vector<double>>& starts) {
   return nlohmann::json{{"kind", "witness"}, {"l", w.index}, {"param", o.param}, {"dir", o.dir}, {"starts", starts},
                         {"rows", w.rows}}
       .dump();
 }
 
-// Runs witness jobs (spec, cache key); answers in job order (an empty object for a job that failed).
 std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector<std::pair<std::string, std::string>>& jobs,
                                            int* solves) {
   std::vector<nlohmann::json> answers(jobs.size(), nlohmann::json::object());
@@ -149,6 +146,8 @@ std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector
   });
   return answers;
 }
+
+namespace {
 
 // The bound of objective `o` that orthant l's box and sign constraints give alone.
 double SignBoxBound(const HwOuterSet& set, const Box& box, int l, const Objective& o) {

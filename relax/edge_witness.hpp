@@ -62,6 +62,15 @@ std::vector<FeasiblePoint> ExtremeFeasiblePoints(const std::vector<Objective>& o
 std::optional<JobOutcome> SettleBySignBeyondWitness(const HwOuterSet& set, const OrthantWork& w, const Objective& o,
                                                     double witnessed);
 
+// The spec of a witness job: a local extreme of objective `o` over orthant w's rows (the kept ones), from
+// `starts` in turn until one gives a feasible point (MakeJobFunction answers {"found", "point", "solves"}).
+std::string WitnessSpec(const OrthantWork& w, const Objective& o, const std::vector<std::vector<double>>& starts);
+
+// Runs witness jobs (spec, cache key) through the cache and the executor; answers in job order (an empty object
+// for a job that failed); adds their local solves to *solves; one progress step per job.
+std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector<std::pair<std::string, std::string>>& jobs,
+                                           int* solves);
+
 EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
                                          const std::vector<Objective>& objectives,
                                          const std::vector<OrthantWork>& orthants);

@@ -13,6 +13,7 @@
 #include "relax/cheap_pass.hpp"
 #include "relax/box_contraction.hpp"
 #include "relax/edge_witness.hpp"
+#include "relax/moment_witness.hpp"
 #include "relax/full_pass.hpp"
 #include "relax/orthant_screen.hpp"
 #include "relax/refine_pass.hpp"
@@ -251,10 +252,11 @@ nlohmann::json BoundsSummary::to_json() const {
                  {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache},
                  {"jobs_stopped_beyond_witness", jobs_stopped_beyond_witness},
                  {"jobs_settled_by_sign", jobs_settled_by_sign},
-                 {"edge_witness_settled", edge_witness_settled}, {"edge_witness_solves", edge_witness_solves}};
+                 {"edge_witness_settled", edge_witness_settled}, {"edge_witness_solves", edge_witness_solves},
+                 {"moment_witness_jobs", moment_witness_jobs}, {"moment_witness_found", moment_witness_found}};
   j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds},
                  {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds},
-                 {"edge_witness_seconds", edge_witness_seconds}};
+                 {"edge_witness_seconds", edge_witness_seconds}, {"moment_witness_seconds", moment_witness_seconds}};
   j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
   j["all_guaranteed"] = all_guaranteed();
   j["contraction_passes_run"] = contraction_passes_run;
@@ -352,7 +354,10 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
       RefineStoppedShortEndpoints(RefinePassOptions{options.order, options.stopped_short_refinements}, ctx, objectives,
                                   wanted_objectives, full, edges.witnessed, orthants);
   full = refined.outcomes;
-  // 7. Aggregate.
+  // 7. Feasible points where the relaxations' moments point (the witnessed ranges; the bounds do not change).
+  const MomentWitnessResult from_moments = FeasiblePointsFromMoments(
+      MomentWitnessOptions{options.moment_witnesses, options.order}, ctx, objectives, wanted_objectives, full, orthants);
+  // 8. Aggregate.
   const AggregateResult agg = AggregateIntervals(
       AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,
       cheap_outcomes, full, orthants);
@@ -360,7 +365,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   BoundsSummary summary;
   summary.intervals = agg.intervals;
   summary.bound_sources = agg.sources;
-  summary.feasible_points = edges.feasible_points;
+  std::vector<FeasiblePoint> feasible = edges.feasible_points;
+  feasible.insert(feasible.end(), from_moments.feasible_points.begin(), from_moments.feasible_points.end());
+  summary.feasible_points = ExtremeFeasiblePoints(objectives, feasible);
   AttachWitnessedRanges(set, summary.feasible_points, summary.intervals);
   summary.clipped_to_box = agg.clipped_to_box;
   summary.contraction_passes_run = cheap.contraction_passes_run;
@@ -394,6 +401,9 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   }
   summary.edge_witness_solves = edges.local_solves;
   summary.edge_witness_seconds = edges.seconds;
+  summary.moment_witness_jobs = from_moments.jobs;
+  summary.moment_witness_found = static_cast<int>(from_moments.feasible_points.size());
+  summary.moment_witness_seconds = from_moments.seconds;
   for (const auto& [key, r] : edges.settled) summary.edge_witness_settled += r.status == "solved" ? 1 : 0;
   summary.sdp_jobs = counters.sdp_jobs;
   summary.sdp_solves = counters.sdp_solves;

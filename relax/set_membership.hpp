@@ -4,10 +4,13 @@
 // The engine is a pipeline of stages, each in its own file (docs: README, "How the bounds are computed"):
 //  1. screen orthants   (relax/orthant_screen.hpp): an LP per sign orthant; infeasible (verified) => empty.
 //  2. reduce rows       (relax/row_reduction.hpp):  drop data rows implied by the others (exact at any order).
-//  3. cheap pass        (relax/cheap_pass.hpp):     every objective of every live orthant at the minimal order.
-//  4. full pass         (relax/full_pass.hpp):      the wanted objectives at order delta, skipping orthants
+//  3. edge witnesses    (relax/edge_witness.hpp):   endpoints at the prior box edge settled by feasible points.
+//  4. cheap pass        (relax/cheap_pass.hpp):     every objective of every live orthant at the minimal order.
+//  5. full pass         (relax/full_pass.hpp):      the wanted objectives at order delta, skipping orthants
 //                                                   whose cheap bound cannot move the interval (Property 3).
-//  5. aggregate         (relax/aggregate.hpp):      min/max over orthants, fallbacks, the prior box.
+//  6. refine            (relax/refine_pass.hpp):    endpoints of solves that stopped short, in contracted boxes.
+//  7. moment witnesses  (relax/moment_witness.hpp): feasible points where the relaxations' moments point.
+//  8. aggregate         (relax/aggregate.hpp):      min/max over orthants, fallbacks, the prior box.
 // Every job (relax/bound_jobs.hpp) solves its relaxation by constraint generation over the kept rows
 // (relax/constraint_generation.hpp): rows enter as scalar moment constraints and get their localizing block
 // when violated; every round's multiplier yields a verified bound, so a solve that stops short still bounds.
@@ -70,6 +73,9 @@ struct BoundsOptions {
   ConstraintGenerationOptions generation;  // its order is set per pass
   RowReductionOptions reduction;           // exact reduction of the data rows (stage 2)
   EdgeWitnessOptions edge_witness;         // endpoints settled by feasible points at the box edge (stage 3)
+  // After the last pass, a local search from every solved job's first moments (relax/moment_witness.hpp): more
+  // certified feasible points, so the witnessed ranges show how close each endpoint is to the exact interval.
+  bool moment_witnesses = true;
   // Progress lines from inside jobs (one per constraint-generation round: working set, status, bound so far).
   // Called in the process that runs the job (a forked worker or an MPI rank); null = silent.
   std::function<void(const std::string&)> round_log;
@@ -136,6 +142,9 @@ struct BoundsSummary {
   int edge_witness_settled = 0;  // (orthant, objective) pairs settled by a feasible point at the box edge
   int edge_witness_solves = 0;   // local optimisations run to find them
   double edge_witness_seconds = 0.0;
+  int moment_witness_jobs = 0;    // local searches started from the relaxations' first moments
+  int moment_witness_found = 0;   // of them, certified feasible points
+  double moment_witness_seconds = 0.0;
   double median_solve_seconds = 0.0;
   double solve_seconds = 0.0, verify_seconds = 0.0;  // totals over the jobs run (cache excluded); verify incl. re-solves
   std::size_t largest_moments = 0, largest_blocks = 0;
