@@ -354,9 +354,11 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
       RefineStoppedShortEndpoints(RefinePassOptions{options.order, options.stopped_short_refinements}, ctx, objectives,
                                   wanted_objectives, full, edges.witnessed, orthants);
   full = refined.outcomes;
-  // 7. Feasible points where the relaxations' moments point (the witnessed ranges; the bounds do not change).
+  // 7. Feasible points where the relaxations' moments point (the witnessed ranges; the bounds do not change). Not
+  // below the edge-witness stage's order: there the SDP jobs cost less than the local searches.
   const MomentWitnessResult from_moments = FeasiblePointsFromMoments(
-      MomentWitnessOptions{options.moment_witnesses, options.order}, ctx, objectives, wanted_objectives, full, orthants);
+      MomentWitnessOptions{options.moment_witnesses && options.order >= options.edge_witness.min_order, options.order},
+      ctx, objectives, wanted_objectives, full, orthants);
   // 8. Aggregate.
   const AggregateResult agg = AggregateIntervals(
       AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,

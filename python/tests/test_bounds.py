@@ -145,3 +145,20 @@ def test_ctrl_c_stops_a_long_run_promptly_and_cleanly():
     assert p.returncode == 0, p.stderr
     assert "interrupted after" in p.stdout and "children left: no" in p.stdout, p.stdout + p.stderr
     assert float(p.stdout.split("after ")[1].split(" s")[0]) < 3.0, p.stdout
+
+
+def test_moment_witnesses_switch_as_in_the_cli(recording, tmp_path):
+    path, rec = recording
+    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 2, "--params", "a1",
+            "--solver", "csdp", "--threads", 2, "--no-moment-witnesses", "--quiet", "--json", tmp_path / "cli.json")
+    cli = load_json(tmp_path / "cli.json")
+    off = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=2, parameters=["a1"],
+                          solver="csdp", threads=2, moment_witnesses=False, source=path)
+    on = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=2, parameters=["a1"],
+                         solver="csdp", threads=2, source=path)
+    assert without(off, "timing") == without(cli, "timing")
+    assert off["counts"]["moment_witness_jobs"] == 0
+    assert on["counts"]["moment_witness_jobs"] > 0
+    # The stage adds feasible points only: the bounds stay.
+    for a, b in zip(on["intervals"], off["intervals"]):
+        assert (a["lower"]["value"], a["upper"]["value"]) == (b["lower"]["value"], b["upper"]["value"])
