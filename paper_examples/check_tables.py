@@ -21,7 +21,6 @@ Usage: check_tables.py [--hwbounds CLI] [--no-witnesses] [--grid OUT.md] PATH...
                  ratios to the paper
 Prints every violation as `file: case: parameter: what`; exits 1 if there is one, 2 on bad usage or input.
 """
-import csv
 import glob
 import json
 import math
@@ -31,7 +30,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from check_dss_witness import NAMES, min_relative_slack  # noqa: E402  (the independent Result 1)
+from check_dss_witness import NAMES, load, min_relative_slack  # noqa: E402  (the independent Result 1)
 
 CONTAINMENT_TOLERANCE = 1e-6   # relative, as cerone_tables: verified endpoints are rounded outward
 SLACK_ALLOWANCE = 1e-9         # relative slack: witnesses are certified with a rounding allowance
@@ -185,26 +184,29 @@ def check_across_runs(checker, tables):
                                          f"{parameter} {side} witness of n = {wcase['n']} in {where_w}")
 
 
-def simulate(cli, case, folder):
-    path = os.path.join(folder, f"snr{case['snr_db']:g}_seed{case['seed']}_N{case['samples']}.csv")
-    if not os.path.exists(path):
+def recording(cli, case, folder, loaded):
+    """(u, y, noise bound) of the case's realisation, simulated by the CLI once per realisation."""
+    key = realisation(case)
+    if key not in loaded:
+        path = os.path.join(folder, f"snr{case['snr_db']:g}_seed{case['seed']}_N{case['samples']}.csv")
         command = [cli, "simulate", "--example", "cerone2011", "--seed", str(case["seed"]), "--samples",
                    str(case["samples"]), "--snr-db", repr(case["snr_db"]), "--out", path]
         try:
             subprocess.run(command, check=True, capture_output=True, text=True)
         except (OSError, subprocess.CalledProcessError) as e:
             usage_error(f"cannot simulate the recording with {' '.join(command)}: {getattr(e, 'stderr', e)}")
-    rows = list(csv.DictReader(open(path)))
-    return ([float(r["u"]) for r in rows], [float(r["y"]) for r in rows], [float(r["noise_bound"]) for r in rows])
+        loaded[key] = load(path)
+    return loaded[key]
 
 
 def recertify_witnesses(checker, tables, cli):
     """Each witness inside D^ss(n) by the independent Result 1; returns the smallest slack seen."""
     smallest = math.inf
+    loaded = {}
     with tempfile.TemporaryDirectory() as folder:
         for where, table in tables:
             for case in table["cases"]:
-                u, y, dy = simulate(cli, case, folder)
+                u, y, dy = recording(cli, case, folder, loaded)
                 if abs(dy[0] - case["noise_bound"]) > 1e-12 * case["noise_bound"]:
                     checker.fail(where, case, "-", f"the simulated recording's noise bound {dy[0]} is not the "
                                  f"table's {case['noise_bound']}: not the same realisation")
