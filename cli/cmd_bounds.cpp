@@ -70,6 +70,7 @@ struct BoundsCliOptions {
   bool proper = false, no_cheap = false, no_edge_witnesses = false, no_moment_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
   int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
+  int endpoint_refinements = 0;
   int row_block_order = -1;
 };
 
@@ -140,6 +141,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.generation.retry_undecided_rounds = o.solver_retry;
   options.contraction_passes = o.contraction_passes;
   options.stopped_short_refinements = o.stopped_short_refinements;
+  options.endpoint_refinements = o.endpoint_refinements;
   options.generation.block_order_cap = o.row_block_order;
   options.parameters = o.params;
   options.generation.verify.enabled = !o.no_verify;
@@ -240,6 +242,9 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
   if (summary.refine_jobs > 0)
     fmt::print("{} endpoint job(s) solved again in a contracted box after a solve stopped short; {} bound(s) "
                "tightened\n", summary.refine_jobs, summary.refine_tightened);
+  if (summary.endpoint_refine_jobs > 0)
+    fmt::print("{} endpoint job(s) solved again in the box of the full pass's own bounds; {} bound(s) tightened\n",
+               summary.endpoint_refine_jobs, summary.endpoint_refine_tightened);
   if (summary.jobs_settled_by_sign > 0)
     fmt::print("{} relaxation job(s) not run: the orthant's sign constraints already bound them at or beyond a "
                "certified feasible point's value\n", summary.jobs_settled_by_sign);
@@ -361,6 +366,11 @@ void AddBoundsCommand(CLI::App& app) {
                   "times an endpoint resting on a solve that stopped short (partial success, pFEAS) is solved again "
                   "in its orthant's box contracted to the verified bounds (0 = never)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--endpoint-refinements", o->endpoint_refinements,
+                  "times every endpoint no certified feasible point reaches is solved again at full order in its "
+                  "orthant's box contracted to the full pass's verified bounds, 0..10 (0 = never; one full-order job "
+                  "per endpoint)")
+      ->check(CLI::Range(0, relax::kMaxEndpointRefinements));
   auto* verify = cmd->add_flag("--verify", o->verify,
                                "verify every bound and emptiness certificate rigorously in interval arithmetic "
                                "(the default)");

@@ -1,5 +1,7 @@
 #include "relax/refine_pass.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -15,9 +17,14 @@ bool Usable(const JobOutcome& r) { return r.status == "solved" || r.status == "s
 
 }  // namespace
 
-std::vector<std::pair<int, int>> StoppedShortEndpoints(const std::vector<Objective>& objectives,
-                                                       const std::vector<int>& wanted, const PassOutcomes& full,
-                                                       const std::vector<OrthantWork>& orthants) {
+namespace {
+
+// Solved outcomes of live orthants among `wanted` that are their objective's endpoint (no other live orthant's
+// solved or skipped bound lies beyond) and that `qualifies` accepts. Ascending order.
+template <typename Qualifies>
+std::vector<std::pair<int, int>> EndpointsWhere(const std::vector<Objective>& objectives,
+                                                const std::vector<int>& wanted, const PassOutcomes& full,
+                                                const std::vector<OrthantWork>& orthants, Qualifies qualifies) {
   std::vector<std::pair<int, int>> out;
   const std::set<int> wanted_set(wanted.begin(), wanted.end());
   std::set<int> alive;
@@ -25,7 +32,7 @@ std::vector<std::pair<int, int>> StoppedShortEndpoints(const std::vector<Objecti
     if (!w.empty()) alive.insert(w.index);
   for (const auto& [key, r] : full) {
     const auto [l, o] = key;
-    if (!alive.count(l) || !wanted_set.count(o) || r.status != "solved" || !r.unfinished) continue;
+    if (!alive.count(l) || !wanted_set.count(o) || r.status != "solved" || !qualifies(o, r)) continue;
     const int dir = objectives[o].dir;
     bool endpoint = true;
     for (const auto& [other_key, other] : full)
@@ -37,7 +44,26 @@ std::vector<std::pair<int, int>> StoppedShortEndpoints(const std::vector<Objecti
   return out;
 }
 
-RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, EngineContext& ctx,
+}  // namespace
+
+std::vector<std::pair<int, int>> StoppedShortEndpoints(const std::vector<Objective>& objectives,
+                                                       const std::vector<int>& wanted, const PassOutcomes& full,
+                                                       const std::vector<OrthantWork>& orthants) {
+  return EndpointsWhere(objectives, wanted, full, orthants, [](int, const JobOutcome& r) { return r.unfinished; });
+}
+
+std::vector<std::pair<int, int>> OpenEndpoints(const std::vector<Objective>& objectives, const std::vector<int>& wanted,
+                                               const PassOutcomes& full, const std::vector<OrthantWork>& orthants,
+                                               const std::map<int, double>& witnessed) {
+  return EndpointsWhere(objectives, wanted, full, orthants, [&](int o, const JobOutcome& r) {
+    const auto it = witnessed.find(o);
+    if (it == witnessed.end()) return true;
+    const double allowance = 1e-6 * std::max(1.0, std::abs(it->second));
+    return Beyond(objectives[o].dir, r.bound, it->second + objectives[o].dir * allowance);
+  });
+}
+
+RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx,
                                              const std::vector<Objective>& objectives,
                                              const std::vector<int>& wanted, const PassOutcomes& full,
                                              const std::map<int, double>& witnessed,
@@ -48,7 +74,9 @@ RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, E
   for (std::size_t i = 0; i < orthants.size(); ++i) position[orthants[i].index] = i;
   const bool verify_on = ctx.options.generation.verify.enabled;
   for (int pass = 0; pass < options.passes; ++pass) {
-    const auto targets = StoppedShortEndpoints(objectives, wanted, result.outcomes, orthants);
+    const auto targets = options.every_endpoint
+                             ? OpenEndpoints(objectives, wanted, result.outcomes, orthants, witnessed)
+                             : StoppedShortEndpoints(objectives, wanted, result.outcomes, orthants);
     if (targets.empty()) break;
     ++result.passes_run;
     // The targets' orthants, contracted to this pass's verified bounds, with their rows reduced again; an
@@ -67,7 +95,9 @@ RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, E
                       StopBeyond(witnessed, o)});
       job_key.push_back({l, o});
     }
-    ctx.progress.Phase("order " + std::to_string(options.order) + " again where a solve stopped short",
+    ctx.progress.Phase("order " + std::to_string(options.order) +
+                           (options.every_endpoint ? " again in the box of its own bounds"
+                                                   : " again where a solve stopped short"),
                        static_cast<int>(jobs.size()));
     const auto outs = RunRelaxationJobs(ctx, jobs, orthants);
     result.jobs_run += static_cast<int>(jobs.size());

@@ -18,6 +18,7 @@ namespace hw::relax {
 struct RefinePassOptions {
   int order = 3;
   int passes = 1;  // contraction-and-solve rounds (0: off)
+  bool every_endpoint = false;  // every open endpoint, not only those resting on a solve that stopped short
 };
 
 struct RefinePassResult {
@@ -33,7 +34,13 @@ std::vector<std::pair<int, int>> StoppedShortEndpoints(const std::vector<Objecti
                                                        const std::vector<int>& wanted, const PassOutcomes& full,
                                                        const std::vector<OrthantWork>& orthants);
 
-RefinePassResult RefineStoppedShortEndpoints(const RefinePassOptions& options, EngineContext& ctx,
+// (orthant, objective) pairs among `wanted` whose solved outcome is the endpoint and lies beyond the value a
+// certified feasible point attains (`witnessed`, per objective), by more than 1e-6 * max(1, |value|).
+std::vector<std::pair<int, int>> OpenEndpoints(const std::vector<Objective>& objectives, const std::vector<int>& wanted,
+                                               const PassOutcomes& full, const std::vector<OrthantWork>& orthants,
+                                               const std::map<int, double>& witnessed);
+
+RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx,
                                              const std::vector<Objective>& objectives,
                                              const std::vector<int>& wanted, const PassOutcomes& full,
                                              const std::map<int, double>& witnessed,

@@ -173,6 +173,8 @@ bool BoundsOptions::IsValid(std::string* error) const {
   if (!ValidThreads(threads, error) || !ValidContractionPasses(contraction_passes, error)) return false;
   if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
   if (stopped_short_refinements < 0) return fail("stopped_short_refinements must be >= 0");
+  if (endpoint_refinements < 0 || endpoint_refinements > kMaxEndpointRefinements)
+    return fail(fmt::format("endpoint_refinements must lie in 0..{}", kMaxEndpointRefinements));
   if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
   if (!ValidBoundsSolver(solver, error)) return false;
   if (!reduction.IsValid(error)) return false;
@@ -261,6 +263,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["all_guaranteed"] = all_guaranteed();
   j["contraction_passes_run"] = contraction_passes_run;
   j["stopped_short_refined"] = {{"jobs", refine_jobs}, {"tightened", refine_tightened}};
+  j["endpoints_refined"] = {{"jobs", endpoint_refine_jobs}, {"tightened", endpoint_refine_tightened}};
   j["row_reduction"] = row_reduction;
   j["bound_sources"] = bound_sources;
   j["clipped_to_prior_box"] = clipped_to_box;
@@ -351,9 +354,14 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
                        edges.settled, edges.witnessed, orthants);
   // 6. Solve again, in contracted boxes, the endpoints that rest on a solve that stopped short.
   const RefinePassResult refined =
-      RefineStoppedShortEndpoints(RefinePassOptions{options.order, options.stopped_short_refinements}, ctx, objectives,
-                                  wanted_objectives, full, edges.witnessed, orthants);
+      RefineEndpoints(RefinePassOptions{options.order, options.stopped_short_refinements, false}, ctx, objectives,
+                      wanted_objectives, full, edges.witnessed, orthants);
   full = refined.outcomes;
+  // 6b. Solve every open endpoint again in the box of the full pass's own bounds (off by default).
+  const RefinePassResult endpoints_refined =
+      RefineEndpoints(RefinePassOptions{options.order, options.endpoint_refinements, true}, ctx, objectives,
+                      wanted_objectives, full, edges.witnessed, orthants);
+  full = endpoints_refined.outcomes;
   // 7. Feasible points where the relaxations' moments point (the witnessed ranges; the bounds do not change). Not
   // below the edge-witness stage's order: there the SDP jobs cost less than the local searches.
   const MomentWitnessResult from_moments = FeasiblePointsFromMoments(
@@ -375,6 +383,8 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.contraction_passes_run = cheap.contraction_passes_run;
   summary.refine_jobs = refined.jobs_run;
   summary.refine_tightened = refined.bounds_tightened;
+  summary.endpoint_refine_jobs = endpoints_refined.jobs_run;
+  summary.endpoint_refine_tightened = endpoints_refined.bounds_tightened;
   summary.order = options.order;
   summary.horizon = set.horizon();
   summary.solver = SolverForOrder(options.solver, options.order, options.generation.block_order_cap);

@@ -70,6 +70,10 @@ struct BoundsOptions {
   // "partial success", SDPA pFEAS) is solved again in its orthant's box contracted to that pass's verified bounds,
   // up to this many times (relax/refine_pass.hpp); the tighter bound is kept. 0 = off.
   int stopped_short_refinements = 1;
+  // Then every endpoint that no certified feasible point reaches, finished or not, is solved again the same way,
+  // up to this many times (relax/refine_pass.hpp): the full pass started in boxes contracted to the cheap order's
+  // bounds, the refinement runs in boxes contracted to its own. 0 = off (costs one full-order job per endpoint).
+  int endpoint_refinements = 0;
   ConstraintGenerationOptions generation;  // its order is set per pass
   RowReductionOptions reduction;           // exact reduction of the data rows (stage 2)
   EdgeWitnessOptions edge_witness;         // endpoints settled by feasible points at the box edge (stage 3)
@@ -164,6 +168,8 @@ struct BoundsSummary {
   int contraction_passes_run = 0;
   // Endpoints solved again where a solve stopped short (BoundsOptions::stopped_short_refinements).
   int refine_jobs = 0, refine_tightened = 0;
+  // Endpoints solved again in the box of the full pass's own bounds (BoundsOptions::endpoint_refinements).
+  int endpoint_refine_jobs = 0, endpoint_refine_tightened = 0;
   // Exact row reduction per live orthant: {"orthant", "per_step": [{"step", "rows", "kept"}]}.
   std::vector<nlohmann::json> row_reduction;
   // Where the orthant bounds entering the endpoints came from (see relax/aggregate.hpp).
@@ -183,6 +189,8 @@ struct BoundsSummary {
 // setting as the Python keyword (the CLI adds its option's spelling in front).
 // (The horizon's check, ValidHorizon, and MinimalOrder are in relax/hw_outer_set.hpp.)
 constexpr int kMaxOrder = 20;
+// Refinements of every open endpoint (BoundsOptions::endpoint_refinements): 0..kMaxEndpointRefinements.
+constexpr int kMaxEndpointRefinements = 10;
 // A relaxation order asked for at horizon n: MinimalOrder(n)..kMaxOrder.
 bool ValidOrder(int order, int horizon, std::string* error);
 // Parallel jobs: 0 (one per core) or more.

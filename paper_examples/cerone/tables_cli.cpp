@@ -33,6 +33,11 @@ void AddOptions(CLI::App& app, CommandLine& cl, TablesOptions& o) {
                  "localizing order of the data rows' blocks at most (-1: full; 1 at order 3: the mixed relaxation)")
       ->capture_default_str();
   app.add_option("--contract-passes", o.bounds.contraction_passes, "cheap passes in contracted boxes (0 = off)");
+  app.add_option("--endpoint-refinements", o.bounds.endpoint_refinements,
+                 "times every open endpoint is solved again at full order in the box of the full pass's own bounds "
+                 "(0 = never)")
+      ->check(CLI::Range(0, hw::relax::kMaxEndpointRefinements))
+      ->capture_default_str();
   app.add_flag("--nest-horizons,!--no-nest-horizons", o.nest_horizons,
                "start each horizon's outer runs in the box of the shorter horizon's outer intervals (default on)");
   app.add_flag("--verify,!--no-verify", o.bounds.generation.verify.enabled, "verify every endpoint (default on)");

@@ -122,12 +122,12 @@ std::string SettingsMarkdown(const TablesReport& r) {
   const auto& o = r.options;
   return fmt::format(
       "Command: `{}`\n\nN = {}, horizons {}, orders {} (outer intervals computed at orders {} and SNR {} dB), seeds "
-      "{}, prior box ±{:g}, solver {}, data-row block order cap {}, verification {}. Inner hull: local optimisation "
+      "{}, prior box ±{:g}, solver {}, data-row block order cap {}, endpoint refinements {}, verification {}. Inner hull: local optimisation "
       "from the truth, {} pseudo-random starts per objective and {} restart round(s) from other witnesses and from "
       "the outer runs' certified feasible points (every live orthant's); every witness certified by evaluating every inequality of its orthant with a rounding allowance. Outer "
       "intervals marked * have a conservative endpoint; an inner hull marked (box) reaches the prior box.\n\n",
       r.command, o.samples, ListText(o.horizons), ListText(o.orders), ListText(o.outer_orders), ListText(o.outer_snrs),
-      ListText(o.seeds), o.box, o.bounds.solver, o.bounds.generation.block_order_cap,
+      ListText(o.seeds), o.box, o.bounds.solver, o.bounds.generation.block_order_cap, o.bounds.endpoint_refinements,
       o.bounds.generation.verify.enabled ? "on" : "off", o.inner.random_starts, o.inner.restart_rounds);
 }
 
@@ -204,6 +204,7 @@ nlohmann::json TablesJson(const TablesReport& report) {
                         {"outer_orders", o.outer_orders}, {"snr_db", o.snrs}, {"outer_snr_db", o.outer_snrs},
                         {"seeds", o.seeds}, {"params", o.params}, {"box", o.box}, {"solver", o.bounds.solver},
                         {"row_block_order", o.bounds.generation.block_order_cap},
+                        {"endpoint_refinements", o.bounds.endpoint_refinements},
                         {"verify", o.bounds.generation.verify.enabled}, {"inner_random_starts", o.inner.random_starts},
                         {"inner_restart_rounds", o.inner.restart_rounds}, {"tolerance", o.tolerance},
                         {"nest_horizons", o.nest_horizons}}},
