@@ -15,10 +15,6 @@ bool Beyond(int dir, double a, double b) { return dir < 0 ? a < b : a > b; }
 
 bool Usable(const JobOutcome& r) { return r.status == "solved" || r.status == "skipped"; }
 
-}  // namespace
-
-namespace {
-
 // Solved outcomes of live orthants among `wanted` that are their objective's endpoint (no other live orthant's
 // solved or skipped bound lies beyond) and that `qualifies` accepts. Ascending order.
 template <typename Qualifies>
@@ -64,10 +60,9 @@ std::vector<std::pair<int, int>> OpenEndpoints(const std::vector<Objective>& obj
 }
 
 RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx,
-                                             const std::vector<Objective>& objectives,
-                                             const std::vector<int>& wanted, const PassOutcomes& full,
-                                             const std::map<int, double>& witnessed,
-                                             std::vector<OrthantWork>& orthants) {
+                                 const std::vector<Objective>& objectives, const std::vector<int>& wanted,
+                                 const PassOutcomes& full, const std::map<int, double>& witnessed,
+                                 std::vector<OrthantWork>& orthants) {
   RefinePassResult result;
   result.outcomes = full;
   std::map<int, std::size_t> position;  // orthant index -> position in `orthants`

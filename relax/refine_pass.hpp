@@ -41,9 +41,8 @@ std::vector<std::pair<int, int>> OpenEndpoints(const std::vector<Objective>& obj
                                                const std::map<int, double>& witnessed);
 
 RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx,
-                                             const std::vector<Objective>& objectives,
-                                             const std::vector<int>& wanted, const PassOutcomes& full,
-                                             const std::map<int, double>& witnessed,
-                                             std::vector<OrthantWork>& orthants);
+                                 const std::vector<Objective>& objectives, const std::vector<int>& wanted,
+                                 const PassOutcomes& full, const std::map<int, double>& witnessed,
+                                 std::vector<OrthantWork>& orthants);
 
 }  // namespace hw::relax
