@@ -20,6 +20,33 @@ JobOutcome Solved(double bound, bool unfinished) {
   return r;
 }
 
+// The seeded N = 60, horizon-1 instance of the paper's example in the prior box +-10.
+HwOuterSet SeededHorizon1Set() {
+  const auto ex = SimulateCeroneExample(3, 60, 31.0);
+  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  return HwOuterSet(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+}
+
+// Every refined interval inside the plain one, containing the truth, both endpoints verified; returns how many
+// are narrower.
+int ExpectInsideWithTheTruthAndVerified(const BoundsSummary& plain, const BoundsSummary& refined) {
+  const auto truth = CeroneExample::TrueParameters();
+  EXPECT_EQ(plain.intervals.size(), refined.intervals.size());
+  int narrower = 0;
+  for (std::size_t k = 0; k < refined.intervals.size() && k < plain.intervals.size(); ++k) {
+    const auto& a = plain.intervals[k];
+    const auto& b = refined.intervals[k];
+    EXPECT_GE(b.lower.value, a.lower.value) << b.name;
+    EXPECT_LE(b.upper.value, a.upper.value) << b.name;
+    EXPECT_LE(b.lower.value, truth[k] + 1e-6) << b.name;
+    EXPECT_GE(b.upper.value, truth[k] - 1e-6) << b.name;
+    EXPECT_EQ(b.lower.verification, "verified") << b.name;
+    EXPECT_EQ(b.upper.verification, "verified") << b.name;
+    narrower += (b.upper.value - b.lower.value < a.upper.value - a.lower.value - 1e-9);
+  }
+  return narrower;
+}
+
 TEST(RefinePass, OnlyStoppedShortBoundsThatAreTheEndpointQualify) {
   const std::vector<Objective> objectives{{0, -1}, {0, +1}, {1, -1}};
   std::vector<OrthantWork> orthants(4);
@@ -75,9 +102,7 @@ TEST(RefinePass, OpenEndpointsAreTheSolvedEndpointsNoWitnessReaches) {
 }
 
 TEST(RefinePass, EveryEndpointRefinedInItsOwnBoxLiesInsideAndKeepsTheTruth) {
-  const auto ex = SimulateCeroneExample(3, 60, 31.0);
-  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+  const HwOuterSet set = SeededHorizon1Set();
   BoundsOptions options;
   options.order = 1;
   options.solver = "csdp";
@@ -88,20 +113,7 @@ TEST(RefinePass, EveryEndpointRefinedInItsOwnBoxLiesInsideAndKeepsTheTruth) {
   EXPECT_EQ(plain.endpoint_refine_jobs, 0);
   EXPECT_GT(refined.endpoint_refine_jobs, 0) << "no open endpoint: the test proves nothing";
   EXPECT_GT(refined.endpoint_refine_tightened, 0);
-  const auto truth = CeroneExample::TrueParameters();
-  ASSERT_EQ(plain.intervals.size(), refined.intervals.size());
-  int narrower = 0;
-  for (std::size_t k = 0; k < refined.intervals.size(); ++k) {
-    const auto& a = plain.intervals[k];
-    const auto& b = refined.intervals[k];
-    EXPECT_GE(b.lower.value, a.lower.value) << b.name;
-    EXPECT_LE(b.upper.value, a.upper.value) << b.name;
-    EXPECT_LE(b.lower.value, truth[k] + 1e-6) << b.name;
-    EXPECT_GE(b.upper.value, truth[k] - 1e-6) << b.name;
-    EXPECT_EQ(b.lower.verification, "verified") << b.name;
-    EXPECT_EQ(b.upper.verification, "verified") << b.name;
-    narrower += (b.upper.value - b.lower.value < a.upper.value - a.lower.value - 1e-9);
-  }
+  const int narrower = ExpectInsideWithTheTruthAndVerified(plain, refined);
   EXPECT_GT(narrower, 0);
   EXPECT_EQ(refined.to_json()["endpoints_refined"]["jobs"], refined.endpoint_refine_jobs);
   options.endpoint_refinements = kMaxEndpointRefinements + 1;
@@ -113,9 +125,7 @@ TEST(RefinePass, EveryEndpointRefinedInItsOwnBoxLiesInsideAndKeepsTheTruth) {
 }
 
 TEST(RefinePass, RefinedIntervalsLieInsideAndKeepTheTruth) {
-  const auto ex = SimulateCeroneExample(3, 60, 31.0);
-  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+  const HwOuterSet set = SeededHorizon1Set();
   BoundsOptions options;
   options.order = 1;
   options.solver = "csdp";
@@ -129,20 +139,7 @@ TEST(RefinePass, RefinedIntervalsLieInsideAndKeepTheTruth) {
   EXPECT_EQ(plain.refine_jobs, 0);
   EXPECT_GT(refined.refine_jobs, 0) << "no endpoint stopped short: the test proves nothing";
   EXPECT_GT(refined.refine_tightened, 0);
-  const auto truth = CeroneExample::TrueParameters();
-  ASSERT_EQ(plain.intervals.size(), refined.intervals.size());
-  int narrower = 0;
-  for (std::size_t k = 0; k < refined.intervals.size(); ++k) {
-    const auto& a = plain.intervals[k];
-    const auto& b = refined.intervals[k];
-    EXPECT_GE(b.lower.value, a.lower.value) << b.name;
-    EXPECT_LE(b.upper.value, a.upper.value) << b.name;
-    EXPECT_LE(b.lower.value, truth[k] + 1e-6) << b.name;
-    EXPECT_GE(b.upper.value, truth[k] - 1e-6) << b.name;
-    EXPECT_EQ(b.lower.verification, "verified") << b.name;
-    EXPECT_EQ(b.upper.verification, "verified") << b.name;
-    narrower += (b.upper.value - b.lower.value < a.upper.value - a.lower.value - 1e-9);
-  }
+  const int narrower = ExpectInsideWithTheTruthAndVerified(plain, refined);
   EXPECT_GT(narrower, 0);
   std::printf("refine jobs %d, bounds tightened %d, narrower intervals %d\n", refined.refine_jobs,
               refined.refine_tightened, narrower);
