@@ -115,6 +115,10 @@ void CheckBoundsOptions(const BoundsCliOptions& o) {
   RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
   RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
   RequireOption("--row-block-order", [&](std::string* e) { return relax::ValidBlockOrderCap(o.row_block_order, e); });
+  RequireOption("--stopped-short-refinements",
+                [&](std::string* e) { return relax::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
+  RequireOption("--endpoint-refinements",
+                [&](std::string* e) { return relax::ValidEndpointRefinements(o.endpoint_refinements, e); });
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
@@ -364,13 +368,11 @@ void AddBoundsCommand(CLI::App& app) {
                   "cheap passes repeated in each orthant's contracted box, 0..10 (0 = no box contraction)");
   cmd->add_option("--stopped-short-refinements", o->stopped_short_refinements,
                   "times an endpoint resting on a solve that stopped short (partial success, pFEAS) is solved again "
-                  "in its orthant's box contracted to the verified bounds (0 = never)")
-      ->check(CLI::NonNegativeNumber);
+                  "in its orthant's box contracted to the verified bounds (0 = never)");
   cmd->add_option("--endpoint-refinements", o->endpoint_refinements,
                   "times every endpoint no certified feasible point reaches is solved again at full order in its "
                   "orthant's box contracted to the full pass's verified bounds, 0..10 (0 = never; one full-order job "
-                  "per endpoint)")
-      ->check(CLI::Range(0, relax::kMaxEndpointRefinements));
+                  "per endpoint)");
   auto* verify = cmd->add_flag("--verify", o->verify,
                                "verify every bound and emptiness certificate rigorously in interval arithmetic "
                                "(the default)");

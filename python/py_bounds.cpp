@@ -98,6 +98,9 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   Require([&](std::string* e) { return relax::ValidThreads(a.options.threads, e); });
   Require([&](std::string* e) { return sdp::ValidExecutorName(a.executor, e); });
   Require([&](std::string* e) { return relax::ValidContractionPasses(a.options.contraction_passes, e); });
+  Require([&](std::string* e) { return relax::ValidBlockOrderCap(a.options.generation.block_order_cap, e); });
+  Require([&](std::string* e) { return relax::ValidStoppedShortRefinements(a.options.stopped_short_refinements, e); });
+  Require([&](std::string* e) { return relax::ValidEndpointRefinements(a.options.endpoint_refinements, e); });
   if (a.executor == "mpi")
     throw py::value_error(
         "executor 'mpi' runs under mpirun from the CLI (`hwbounds bounds --executor mpi`); use "
@@ -137,8 +140,8 @@ void DefineBounds(py::module_& m) {
          std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
-         int contraction_passes, double contraction_min_shrink,
-         int contraction_max_rounds, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
+         int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
+         int row_block_order, int stopped_short_refinements, int endpoint_refinements, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
          py::object progress, std::string source) {
         BoundsArgs a;
         a.structure.na = na;
@@ -165,6 +168,9 @@ void DefineBounds(py::module_& m) {
         op.contraction_passes = contraction_passes;
         op.contraction_min_shrink = contraction_min_shrink;
         op.contraction_max_rounds = contraction_max_rounds;
+        op.generation.block_order_cap = row_block_order;
+        op.stopped_short_refinements = stopped_short_refinements;
+        op.endpoint_refinements = endpoint_refinements;
         op.generation.max_rounds = max_rounds;
         op.generation.add_per_round = add_per_round;
         op.generation.violation_tolerance = violation_tolerance;
@@ -173,7 +179,9 @@ void DefineBounds(py::module_& m) {
       },
       R"doc(Guaranteed parameter intervals of a Hammerstein-Wiener model from a recording (paper 001), as
 `hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
-Options mirror relax::HwStructure and relax::BoundsOptions (same names, defaults and validation messages).
+Options mirror relax::HwStructure and relax::BoundsOptions (same names, defaults and validation messages);
+row_block_order is the CLI's --row-block-order (generation.block_order_cap: -1 = full order, 1 at order 3 = the
+mixed relaxation with 9x9 data-row blocks).
 box: None (every parameter in [-10, 10]), (lo, hi), {name: (lo, hi)} or one pair per parameter.
 progress: called as progress(dict(phase, done, total, from_cache, elapsed_seconds, eta_seconds)) after each job
 (done/total count the jobs still to run; from_cache those read from run_dir).
@@ -192,7 +200,9 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("full_pass_contraction") = o.contract_before_full_pass,
       py::arg("contraction_passes") = o.contraction_passes,
       py::arg("contraction_min_shrink") = o.contraction_min_shrink,
-      py::arg("contraction_max_rounds") = o.contraction_max_rounds, py::arg("max_rounds") = g.max_rounds,
+      py::arg("contraction_max_rounds") = o.contraction_max_rounds, py::arg("row_block_order") = g.block_order_cap,
+      py::arg("stopped_short_refinements") = o.stopped_short_refinements,
+      py::arg("endpoint_refinements") = o.endpoint_refinements, py::arg("max_rounds") = g.max_rounds,
       py::arg("add_per_round") = g.add_per_round, py::arg("violation_tolerance") = g.violation_tolerance,
       py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data");
 }

@@ -156,6 +156,17 @@ bool ValidContractionPasses(int passes, std::string* error) {
   return Fail(error, fmt::format("contraction_passes {} is out of range 0..10 (0 = no box contraction)", passes));
 }
 
+bool ValidStoppedShortRefinements(int refinements, std::string* error) {
+  if (refinements >= 0) return true;
+  return Fail(error, fmt::format("stopped_short_refinements {} is negative; give 0 (never) or more", refinements));
+}
+
+bool ValidEndpointRefinements(int refinements, std::string* error) {
+  if (refinements >= 0 && refinements <= kMaxEndpointRefinements) return true;
+  return Fail(error, fmt::format("endpoint_refinements {} is out of range 0..{} (0 = never)", refinements,
+                                 kMaxEndpointRefinements));
+}
+
 bool ValidBoundsSolver(const std::string& name, std::string* error) {
   if (name == "auto") return true;
   if (sdp::ValidSolverName(name, nullptr)) return true;
@@ -172,9 +183,8 @@ bool BoundsOptions::IsValid(std::string* error) const {
   if (order < 1 || order > kMaxOrder) return fail(fmt::format("order {} is out of range 1..{}", order, kMaxOrder));
   if (!ValidThreads(threads, error) || !ValidContractionPasses(contraction_passes, error)) return false;
   if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
-  if (stopped_short_refinements < 0) return fail("stopped_short_refinements must be >= 0");
-  if (endpoint_refinements < 0 || endpoint_refinements > kMaxEndpointRefinements)
-    return fail(fmt::format("endpoint_refinements must lie in 0..{}", kMaxEndpointRefinements));
+  if (!ValidStoppedShortRefinements(stopped_short_refinements, error)) return false;
+  if (!ValidEndpointRefinements(endpoint_refinements, error)) return false;
   if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
   if (!ValidBoundsSolver(solver, error)) return false;
   if (!reduction.IsValid(error)) return false;

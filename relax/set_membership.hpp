@@ -197,6 +197,10 @@ bool ValidOrder(int order, int horizon, std::string* error);
 bool ValidThreads(int threads, std::string* error);
 // Cheap passes in contracted boxes: 0 (no contraction)..10.
 bool ValidContractionPasses(int passes, std::string* error);
+// Re-solves of an endpoint resting on a solve that stopped short: 0 (never) or more.
+bool ValidStoppedShortRefinements(int refinements, std::string* error);
+// Re-solves of every open endpoint: 0 (never)..kMaxEndpointRefinements.
+bool ValidEndpointRefinements(int refinements, std::string* error);
 // The backend of a bounds run: "auto" or a name of sdp::AvailableSolvers().
 bool ValidBoundsSolver(const std::string& name, std::string* error);
 // The backend that solves the engine's relaxations of this order with data-row blocks capped at

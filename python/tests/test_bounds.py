@@ -162,3 +162,16 @@ def test_moment_witnesses_switch_as_in_the_cli(recording, tmp_path):
     # The stage adds feasible points only: the bounds stay.
     for a, b in zip(on["intervals"], off["intervals"]):
         assert (a["lower"]["value"], a["upper"]["value"]) == (b["lower"]["value"], b["upper"]["value"])
+
+
+def test_row_block_order_and_endpoint_refinements_as_in_the_cli(recording, tmp_path):
+    path, rec = recording
+    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 2, "--params", "a1",
+            "--solver", "csdp", "--threads", 2, "--row-block-order", 0, "--endpoint-refinements", 1, "--quiet",
+            "--json", tmp_path / "cli.json")
+    cli = load_json(tmp_path / "cli.json")
+    py = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=2, parameters=["a1"],
+                         solver="csdp", threads=2, row_block_order=0, endpoint_refinements=1, source=path)
+    assert without(py, "timing") == without(cli, "timing")
+    assert "mixed" in py["relaxation"], py["relaxation"]  # order 2 with data-row blocks of localizing order 0
+    assert py["endpoints_refined"]["jobs"] > 0
