@@ -29,6 +29,15 @@ HwOuterSet SeededHorizon1Set() {
 
 // Every refined interval inside the plain one, containing the truth, both endpoints verified; returns how many
 // are narrower.
+// Order 1 with CSDP in this process: the settings both end-to-end tests start from.
+BoundsOptions Order1InProcessOptions() {
+  BoundsOptions options;
+  options.order = 1;
+  options.solver = "csdp";
+  options.executor = std::make_shared<sdp::InProcessExecutor>();
+  return options;
+}
+
 int ExpectInsideWithTheTruthAndVerified(const BoundsSummary& plain, const BoundsSummary& refined) {
   const auto truth = CeroneExample::TrueParameters();
   EXPECT_EQ(plain.intervals.size(), refined.intervals.size());
@@ -103,10 +112,7 @@ TEST(RefinePass, OpenEndpointsAreTheSolvedEndpointsNoWitnessReaches) {
 
 TEST(RefinePass, EveryEndpointRefinedInItsOwnBoxLiesInsideAndKeepsTheTruth) {
   const HwOuterSet set = SeededHorizon1Set();
-  BoundsOptions options;
-  options.order = 1;
-  options.solver = "csdp";
-  options.executor = std::make_shared<sdp::InProcessExecutor>();
+  BoundsOptions options = Order1InProcessOptions();
   const auto plain = ComputeBounds(options, set);
   options.endpoint_refinements = 1;
   const auto refined = ComputeBounds(options, set);
@@ -126,12 +132,9 @@ TEST(RefinePass, EveryEndpointRefinedInItsOwnBoxLiesInsideAndKeepsTheTruth) {
 
 TEST(RefinePass, RefinedIntervalsLieInsideAndKeepTheTruth) {
   const HwOuterSet set = SeededHorizon1Set();
-  BoundsOptions options;
-  options.order = 1;
-  options.solver = "csdp";
+  BoundsOptions options = Order1InProcessOptions();
   options.generation.retry_undecided_rounds = false;
   options.generation.sdp.max_iterations = 12;  // every solve stops short of optimal
-  options.executor = std::make_shared<sdp::InProcessExecutor>();
   options.stopped_short_refinements = 0;
   const auto plain = ComputeBounds(options, set);
   options.stopped_short_refinements = 2;
