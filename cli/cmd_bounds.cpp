@@ -13,6 +13,7 @@
 #include "core/output_files.hpp"
 #include "core/progress_throttle.hpp"
 #include "core/recording.hpp"
+#include "relax/box_split.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 
@@ -43,6 +44,21 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
   return box;
 }
 
+std::vector<double> parse_list(const std::string& text, const std::string& what);
+
+// "--split gamma2=0" or "--split a1=1.7,1.8 --split b1=0": the prior box is cut at these values (one entry per
+// parameter). The text's syntax is checked here, the values against the box by the library's ValidBoxCuts.
+std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
+  std::vector<relax::BoxCut> cuts;
+  for (const auto& spec : specs) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+      throw InputError(fmt::format("--split '{}': expected NAME=VALUE[,VALUE...], e.g. --split gamma2=0", spec));
+    cuts.push_back({spec.substr(0, eq), parse_list(spec.substr(eq + 1), fmt::format("--split '{}'", spec))});
+  }
+  return cuts;
+}
+
 std::vector<double> parse_list(const std::string& text, const std::string& what) {
   std::vector<double> v;
   std::stringstream ss(text);
@@ -63,7 +79,7 @@ constexpr int kExitInvalidated = 3;
 struct BoundsCliOptions {
   std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
   std::string solver = "auto", json_out, run_dir, truth, executor = "fork";
-  std::vector<std::string> box, params;
+  std::vector<std::string> box, params, split;
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
@@ -191,6 +207,7 @@ bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::
 std::string CertificateText(const relax::EmptinessCertificate& c) {
   const std::string how = c.kind == "lp"               ? "LP screen infeasible"
                           : c.kind == "relaxation"     ? fmt::format("order {} relaxation infeasible", c.order)
+                          : c.kind == "pieces"         ? "proven empty in every piece of the split box"
                                                        : fmt::format("order {} bounds cross", c.order);
   return fmt::format("{}{}, {}", how, c.contracted_box ? " in the contracted box" : "",
                      c.verified ? "verified in interval arithmetic" : "the solver's floating-point certificate (unverified)");
@@ -217,6 +234,32 @@ void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptio
   fmt::print("next: `hwbounds diagnose --data REC --validate REC2 --fit hw:NA,NB,PIN,POUT` looks for what the model "
              "leaves out (docs/diagnose.md); a larger noise bound, other bases or orders, or a wider --box change the "
              "question.\n");
+}
+
+// One line per piece of a split box: its box side(s) that differ from the prior box, and what it gave.
+void PrintPieces(const relax::BoundsSummary& summary) {
+  if (summary.pieces.empty()) return;
+  fmt::print("\nthe prior box split into {} pieces; the intervals above are the hull over the pieces:\n",
+             summary.pieces.size());
+  for (std::size_t k = 0; k < summary.pieces.size(); ++k) {
+    const auto& piece = summary.pieces[k];
+    std::string sides;
+    const auto& box = piece.at("prior_box");
+    for (std::size_t i = 0; i < box.size() && i < summary.box.size(); ++i)
+      if (box[i].at("lo").get<double>() != summary.box[i].first || box[i].at("hi").get<double>() != summary.box[i].second)
+        sides += fmt::format("{}{} in [{}, {}]", sides.empty() ? "" : ", ", box[i].at("parameter").get<std::string>(),
+                             box[i].at("lo").get<double>(), box[i].at("hi").get<double>());
+    std::string result;
+    if (piece.at("invalidated").get<bool>()) {
+      result = "every orthant proven empty";
+    } else {
+      for (const auto& iv : piece.at("intervals"))
+        result += fmt::format("{}{} [{:.6f}, {:.6f}]", result.empty() ? "" : ", ", iv.at("parameter").get<std::string>(),
+                              iv.at("lower").at("value").get<double>(), iv.at("upper").at("value").get<double>());
+    }
+    fmt::print("  piece {} ({}): {}; wall {:.1f} s\n", k + 1, sides, result,
+               piece.at("timing").at("wall_seconds").get<double>());
+  }
 }
 
 void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std::string>& names, bool verify) {
@@ -340,6 +383,10 @@ void AddBoundsCommand(CLI::App& app) {
   auto* order = cmd->add_option("--order", o->order, "relaxation order delta, from the minimal order ceil((n+1)/2) to 20")
                     ->default_str("minimal");
   cmd->add_option("--box", o->box, "prior box: LO,HI for all parameters or NAME=LO,HI")->default_str("-10,10");
+  cmd->add_option("--split", o->split,
+                  "cut the prior box at these values of one parameter, NAME=VALUE[,VALUE...] (repeat for more "
+                  "parameters): each piece is bounded on its own and the intervals are the hull over the pieces, "
+                  "often tighter (README, \"The relaxation gap\")");
   cmd->add_option("--solver", o->solver,
                   fmt::format("SDP backend: auto (CSDP, measured fastest at orders 2 and 3; docs/sdp.md), {}",
                               fmt::join(sdp::AvailableSolvers(), ", ")));
@@ -393,9 +440,11 @@ void AddBoundsCommand(CLI::App& app) {
     const auto names = relax::MakeLayout(structure).names;
     const relax::BoundsOptions options = MakeBoundsOptions(*o);
     const relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
+    const std::vector<relax::BoxCut> cuts = parse_split(o->split);
+    RequireOption("--split", [&](std::string* e) { return relax::ValidBoxCuts(cuts, names, set.box(), e); });
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
-      relax::ComputeBounds(options, set);
+      relax::ComputeBoundsInPieces(options, set, cuts);
       return;
     }
     std::vector<double> truth;
@@ -420,11 +469,12 @@ void AddBoundsCommand(CLI::App& app) {
                  p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
                  p.elapsed_seconds, p.eta_seconds);
     };
-    const auto summary = relax::ComputeBounds(options, set, progress);
+    const auto summary = relax::ComputeBoundsInPieces(options, set, cuts, progress);
     const bool invalidated = summary.invalidated();
     bool covered = true;
     if (invalidated) PrintInvalidation(summary, *o);
     else covered = PrintIntervals(summary, names, truth);
+    PrintPieces(summary);
     PrintRunSummary(summary, names, !o->no_verify);
     if (!invalidated) PrintWarnings(summary, !o->no_verify);
     if (!o->json_out.empty()) {

@@ -194,6 +194,7 @@ bool BoundsOptions::IsValid(std::string* error) const {
 
 std::string EmptinessCertificate::status() const {
   if (kind == "lp") return "empty (LP)";
+  if (kind == "pieces") return order > 0 ? fmt::format("empty in every piece (up to order {})", order) : "empty in every piece (LP)";
   return fmt::format("empty (order {}{}{})", order, contracted_box ? ", contracted box" : "",
                      kind == "crossed bounds" ? ", bounds cross" : "");
 }
@@ -277,6 +278,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["row_reduction"] = row_reduction;
   j["bound_sources"] = bound_sources;
   j["clipped_to_prior_box"] = clipped_to_box;
+  if (!pieces.empty()) j["pieces"] = pieces;
   for (const auto& [l, b] : orthant_boxes) {
     nlohmann::json bj = nlohmann::json::array();
     for (std::size_t i = 0; i < b.size(); ++i)

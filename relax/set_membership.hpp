@@ -111,7 +111,8 @@ struct ParameterInterval {
 // How a sign orthant was proven empty.
 struct EmptinessCertificate {
   // "lp": the LP screen is infeasible; "relaxation": the relaxation of order `order` is infeasible;
-  // "crossed bounds": the rigorous lower and upper bounds of a parameter at order `order` cross.
+  // "crossed bounds": the rigorous lower and upper bounds of a parameter at order `order` cross;
+  // "pieces": empty in every piece of a split box (relax/box_split.hpp), `order` the highest order used there.
   std::string kind;
   int order = 0;                // relaxation order (0 for the LP screen)
   bool contracted_box = false;  // proven in the orthant's contracted box, which holds all its points of the prior box
@@ -177,6 +178,8 @@ struct BoundsSummary {
   // Certified points of D^ss(n) found by the edge-witness stage, the most extreme ones per parameter.
   std::vector<FeasiblePoint> feasible_points;
   bool clipped_to_box = false;
+  // A run over a split box (relax/box_split.hpp): each piece's own summary as JSON, with its box.
+  std::vector<nlohmann::json> pieces;
   nlohmann::json to_json() const;
   bool all_guaranteed() const;
   // Every orthant proven empty (by verified certificates when verification is on): no parameter in the box

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
 #include "tests/test_support.hpp"
@@ -61,6 +63,37 @@ TEST_F(CliIo, OrderZeroOrNegativeIsAnError) {
   }
   const auto pop = Cli(std::string("pop ") + HW_SOURCE_DIR + "/paper_examples/problems/gloptipoly_constrained.json --order 0");
   EXPECT_NE(pop.code, 0) << pop.output;
+}
+
+TEST_F(CliIo, BadSplitIsNamedBeforeAnyWork) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"--split a1", "expected NAME=VALUE[,VALUE...]"},
+      {"--split a1=x", "'x' is not a number"},
+      {"--split a7=0", "no parameter 'a7'"},
+      {"--split a1=10", "not strictly inside its prior box side [-10, 10]"},
+      {"--box a1=0,3 --split a1=-1", "not strictly inside its prior box side [0, 3]"},
+      {"--split a1=0 --split a1=1", "'a1' is cut twice"},
+  };
+  for (const auto& [args, message] : bad) {
+    const auto r = Cli(Bounds(args));
+    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+    EXPECT_TRUE(Has(r.output, "--split")) << args << ": " << r.output;
+    EXPECT_TRUE(Has(r.output, message)) << args << ": " << r.output;
+    EXPECT_FALSE(Has(r.output, "orthants:")) << "it ran: " << r.output;
+  }
+}
+
+TEST_F(CliIo, SplitRunListsItsPiecesAndWritesThemToTheJson) {
+  const auto r = Cli(Bounds("--order 1 --threads 1 --params a1,a2 --split a1=-0.5 --json " + Path("split.json")));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Has(r.output, "the prior box split into 2 pieces")) << r.output;
+  EXPECT_TRUE(Has(r.output, "piece 1 (a1 in [-10, -0.5]): ")) << r.output;
+  EXPECT_TRUE(Has(r.output, "piece 2 (a1 in [-0.5, 10]): ")) << r.output;
+  nlohmann::json j;
+  std::ifstream(Path("split.json")) >> j;
+  ASSERT_EQ(j.at("pieces").size(), 2u);
+  EXPECT_EQ(j.at("pieces")[1].at("prior_box")[4].at("lo").get<double>(), -0.5);
+  EXPECT_EQ(j.at("prior_box")[4].at("lo").get<double>(), -10.0);
 }
 
 TEST_F(CliIo, SimulateRejectsNegativeNoiseAndUnstableModels) {

@@ -1,0 +1,134 @@
+// Bounds over a split prior box (relax/box_split.hpp): the pieces cover the box, the hull over the pieces keeps
+// the guarantees (the weakest status and verification of the pieces it rests on), a piece proven empty drops out,
+// and a run over pieces contains the truth as the whole-box run does.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "core/cerone_example.hpp"
+#include "core/csv_table.hpp"
+#include "relax/box_split.hpp"
+#include "tests/seeded_example.hpp"
+
+namespace hw::relax {
+namespace {
+
+const std::vector<std::string> kNames = {"p", "q", "r"};
+const ParameterBox kBox = {{-1, 1}, {0, 4}, {-2, 2}};
+
+TEST(BoxPieces, CutsOfTwoParametersMultiplyAndCoverTheBox) {
+  const auto pieces = BoxPieces(kBox, {{"q", {3, 1}}, {"r", {0}}}, kNames);
+  ASSERT_EQ(pieces.size(), 6u);  // 3 slabs of q times 2 of r, q varying slowest
+  const std::vector<std::pair<double, double>> q = {{0, 1}, {0, 1}, {1, 3}, {1, 3}, {3, 4}, {3, 4}};
+  const std::vector<std::pair<double, double>> r = {{-2, 0}, {0, 2}, {-2, 0}, {0, 2}, {-2, 0}, {0, 2}};
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    EXPECT_EQ(pieces[k][0], kBox[0]) << k;
+    EXPECT_EQ(pieces[k][1], q[k]) << k;
+    EXPECT_EQ(pieces[k][2], r[k]) << k;
+  }
+  EXPECT_EQ(BoxPieces(kBox, {}, kNames), std::vector<ParameterBox>{kBox});
+}
+
+TEST(BoxPieces, BadCutsAreNamed) {
+  std::string error;
+  EXPECT_TRUE(ValidBoxCuts({{"q", {1, 2}}, {"p", {0}}}, kNames, kBox, &error)) << error;
+  const std::vector<std::pair<std::vector<BoxCut>, std::string>> bad = {
+      {{{"s", {0}}}, "no parameter 's'; the parameters are: p, q, r"},
+      {{{"q", {4}}}, "the cut q = 4 is not strictly inside its prior box side [0, 4]"},
+      {{{"q", {-1}}}, "not strictly inside"},
+      {{{"q", {1}}, {"q", {2}}}, "'q' is cut twice"},
+      {{{"q", {2, 2}}}, "the cut q = 2 is given twice"},
+      {{{"q", {}}}, "no cut point for 'q'"},
+      {{{"p", {std::nan("")}}}, "not strictly inside"},
+  };
+  for (const auto& [cuts, message] : bad) {
+    error.clear();
+    EXPECT_FALSE(ValidBoxCuts(cuts, kNames, kBox, &error)) << message;
+    EXPECT_NE(error.find(message), std::string::npos) << error;
+  }
+}
+
+// A piece's summary with one interval [lo, hi] of "p" and one orthant of the given status.
+BoundsSummary Piece(double lo, double hi, const std::string& orthant_status, const std::string& verification = "verified") {
+  BoundsSummary s;
+  s.parameter_names = kNames;
+  s.orthants_total = 1;
+  OrthantReport o{0, "p+", orthant_status, std::nullopt};
+  if (orthant_status.rfind("empty", 0) == 0) {
+    o.certificate = EmptinessCertificate{"relaxation", 2, false, verification == "verified"};
+    s.orthants_empty = 1;
+  } else {
+    s.orthants_solved = 1;
+  }
+  s.orthants.push_back(o);
+  ParameterInterval iv;
+  iv.name = "p";
+  iv.lower = {lo, "guaranteed", "", 0, true, verification, 0.0};
+  iv.upper = {hi, "guaranteed", "", 0, true, verification, 0.0};
+  s.intervals.push_back(iv);
+  s.sdp_jobs = 3;
+  return s;
+}
+
+TEST(CombinePieces, HullOverTheLivePiecesWithTheWeakestStatus) {
+  BoundsSummary a = Piece(-0.5, 0.1, "solved");
+  BoundsSummary b = Piece(0.0, 0.7, "solved");
+  b.intervals[0].upper.status = "conservative";
+  b.intervals[0].upper.note = "fallback";
+  const BoundsSummary empty = Piece(-9, 9, "empty (order 2)");  // proven empty: its endpoints do not count
+  const auto hull = CombinePieces({a, empty, b}, kBox);
+  ASSERT_EQ(hull.intervals.size(), 1u);
+  EXPECT_EQ(hull.intervals[0].lower.value, -0.5);
+  EXPECT_EQ(hull.intervals[0].upper.value, 0.7);
+  EXPECT_EQ(hull.intervals[0].lower.status, "guaranteed");
+  EXPECT_EQ(hull.intervals[0].upper.status, "conservative");
+  EXPECT_EQ(hull.intervals[0].upper.note, "piece 3: fallback");
+  EXPECT_EQ(hull.sdp_jobs, 9);
+  EXPECT_EQ(hull.pieces.size(), 3u);
+  EXPECT_TRUE(hull.pieces[1].at("invalidated").get<bool>());
+  EXPECT_EQ(hull.orthants_solved, 1);  // solved in two pieces
+  EXPECT_FALSE(hull.invalidated());
+  EXPECT_EQ(hull.box, kBox);
+
+  // One piece's floating-point bound that verification could not prove makes the hull's endpoint unverified.
+  const BoundsSummary c = Piece(-0.2, 0.2, "solved", "unverified");
+  const auto mixed = CombinePieces({a, c}, kBox);
+  EXPECT_EQ(mixed.intervals[0].lower.verification, "unverified");
+  EXPECT_FALSE(mixed.all_guaranteed());
+}
+
+TEST(CombinePieces, EveryPieceEmptyInvalidatesTheModelWithAVerifiedCertificateOnlyIfAllAre) {
+  const auto all = CombinePieces({Piece(0, 0, "empty (LP)"), Piece(0, 0, "empty (order 2)")}, kBox);
+  EXPECT_TRUE(all.invalidated());
+  ASSERT_TRUE(all.orthants[0].certificate);
+  EXPECT_EQ(all.orthants[0].certificate->kind, "pieces");
+  EXPECT_TRUE(all.orthants[0].certificate->verified);
+  EXPECT_EQ(all.orthants[0].status, "empty in every piece (up to order 2)");
+  const auto weak = CombinePieces({Piece(0, 0, "empty (LP)"), Piece(0, 0, "empty (order 2)", "off")}, kBox);
+  EXPECT_FALSE(weak.orthants[0].certificate->verified);
+}
+
+// End to end on the paper's example (N = 60, n = 1, order 1: seconds): a cut at the truth of a1 and one at
+// a1 = -0.5, below every point of D^ss(1) here, whose piece the engine proves empty.
+TEST(ComputeBoundsInPieces, TheHullContainsTheTruthAndAnEmptyPieceDropsOut) {
+  const HwOuterSet set = SeededSet(3, 60, 1, 31.0);
+  BoundsOptions options;
+  options.order = 1;
+  options.executor = std::make_shared<sdp::ForkExecutor>(2);
+  const auto whole = ComputeBounds(options, set);
+  const auto split = ComputeBoundsInPieces(options, set, {{"a1", {-0.5, 1.8}}});
+  ASSERT_EQ(split.pieces.size(), 3u);
+  EXPECT_TRUE(split.pieces[0].at("invalidated").get<bool>());
+  EXPECT_FALSE(split.pieces[1].at("invalidated").get<bool>());
+  EXPECT_FALSE(split.pieces[2].at("invalidated").get<bool>());
+  CompareEndpoints(split, whole, [](const std::string& name, std::size_t, const Endpoint& x, const Endpoint& y, bool) {
+    EXPECT_TRUE(std::isfinite(x.value) && std::isfinite(y.value)) << name;
+  });
+  const std::size_t a1 = ParameterIndex(split, "a1");
+  EXPECT_GE(split.intervals[a1].lower.value, -0.5);
+  EXPECT_EQ(split.orthants_empty, whole.orthants_empty);
+  EXPECT_THROW(ComputeBoundsInPieces(options, set, {{"a1", {10.0}}}), InputError);
+}
+
+}  // namespace
+}  // namespace hw::relax
