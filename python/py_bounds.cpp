@@ -8,6 +8,7 @@
 
 #include "python/py_convert.hpp"
 #include "python/py_module.hpp"
+#include "relax/box_split.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/job_executor.hpp"
 #include "sdp/sdp_solver.hpp"
@@ -51,6 +52,25 @@ std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::ve
   return box;
 }
 
+// The cuts of the prior box: None (no cut) or {name: value or [values]}, as the CLI's --split NAME=V1,V2; the
+// values are checked against the box by the library (the CLI gets the same message).
+std::vector<relax::BoxCut> SplitFromPython(py::handle h, const std::vector<std::string>& names,
+                                           const std::vector<std::pair<double, double>>& box) {
+  std::vector<relax::BoxCut> cuts;
+  if (h.is_none()) return cuts;
+  if (!py::isinstance<py::dict>(h))
+    throw py::type_error("split: expected None or {name: value or [values]}, e.g. {'gamma2': 0.0}");
+  for (const auto& [k, v] : h.cast<py::dict>()) {
+    const std::string name = py::str(k);
+    const std::string what = "split['" + name + "']";
+    cuts.push_back({name, py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v)
+                              ? std::vector<double>{v.cast<double>()}
+                              : ToVector(v, what)});
+  }
+  Require([&](std::string* e) { return relax::ValidBoxCuts(cuts, names, box, e); });
+  return cuts;
+}
+
 std::vector<double> NoiseBound(py::handle h, std::size_t n) {
   if (py::isinstance<py::float_>(h) || py::isinstance<py::int_>(h)) {
     const double b = h.cast<double>();
@@ -79,8 +99,8 @@ struct BoundsArgs {
   relax::BoundsOptions options;
 };
 
-py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::object progress,
-                  const std::string& source) {
+py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
+                  py::object progress, const std::string& source) {
   relax::HwData data;
   data.source = source;
   data.u = ToVector(u, "u");
@@ -109,6 +129,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   RequireValid(a.options);
   const auto names = relax::MakeLayout(a.structure).names;
   const relax::HwOuterSet set(a.structure, data, a.horizon, BoxFromPython(box, names));
+  const std::vector<relax::BoxCut> cuts = SplitFromPython(split, names, set.box());
   // Ctrl-C is checked while the engine waits for its jobs and at every progress report.
   a.options.executor->set_interrupt_check(CheckPythonSignals);
   auto report = [&progress](const relax::BoundsProgress& p) {
@@ -116,7 +137,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (!progress.is_none()) progress(ProgressDict(p));
   };
-  const auto summary = WithoutGil([&] { return relax::ComputeBounds(a.options, set, report); });
+  const auto summary = WithoutGil([&] { return relax::ComputeBoundsInPieces(a.options, set, cuts, report); });
   nlohmann::json j = summary.to_json();
   j["data"] = source;
   j["data_warnings"] = set.warnings();  // as the CLI writes them
@@ -137,7 +158,8 @@ void DefineBounds(py::module_& m) {
   m.def(
       "bounds",
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
-         std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, std::string solver,
+         std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, py::handle split,
+         std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
@@ -175,7 +197,7 @@ void DefineBounds(py::module_& m) {
         op.generation.add_per_round = add_per_round;
         op.generation.violation_tolerance = violation_tolerance;
         op.generation.verify.enabled = verify;
-        return Bounds(u, y, noise_bound, std::move(a), box, std::move(progress), source);
+        return Bounds(u, y, noise_bound, std::move(a), box, split, std::move(progress), source);
       },
       R"doc(Guaranteed parameter intervals of a Hammerstein-Wiener model from a recording (paper 001), as
 `hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
@@ -183,6 +205,8 @@ Options mirror relax::HwStructure and relax::BoundsOptions (same names, defaults
 row_block_order is the CLI's --row-block-order (generation.block_order_cap: -1 = full order, 1 at order 3 = the
 mixed relaxation with 9x9 data-row blocks).
 box: None (every parameter in [-10, 10]), (lo, hi), {name: (lo, hi)} or one pair per parameter.
+split: None or {name: value or [values]}, the CLI's --split: the box is cut there, each piece bounded on its own,
+and the intervals are the hull over the pieces (each piece's own result under "pieces").
 progress: called as progress(dict(phase, done, total, from_cache, elapsed_seconds, eta_seconds)) after each job
 (done/total count the jobs still to run; from_cache those read from run_dir).
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
@@ -191,7 +215,7 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
       py::arg("input_basis") = "poly:3", py::arg("output_basis") = "poly:3", py::arg("horizon") = 2,
       py::arg("order") = py::none(), py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
-      py::arg("box") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
+      py::arg("box") = py::none(), py::arg("split") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
       py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
       py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,
       py::arg("moment_witnesses") = o.moment_witnesses,

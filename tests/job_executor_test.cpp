@@ -124,9 +124,9 @@ TEST(InProcessExecutor, SameAnswersAsFork) {
 }
 
 #if defined(HW_HAVE_MPI) && defined(HW_CLI_PATH)
-// The whole engine under mpirun (3 ranks: coordinator + 2 workers) against the local fork run.
-TEST(MpiExecutor, SameIntervalsAsTheLocalRun) {
-  if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun not installed";
+// The whole engine under mpirun (3 ranks: coordinator + 2 workers) against the local fork run, with `extra`
+// bounds options; `name` keeps the two cases' files apart.
+void ExpectMpiIntervalsEqualTheLocalRun(const std::string& name, const std::string& extra) {
   const std::string dir = ::testing::TempDir();
   const auto ex = SimulateCeroneExample(5, 60);
   CsvTable t;
@@ -134,15 +134,15 @@ TEST(MpiExecutor, SameIntervalsAsTheLocalRun) {
   t.columns = {ex.u, ex.y};
   write_csv(dir + "/mpi_case.csv", t);
   const std::string common = std::string(HW_CLI_PATH) + " bounds --data " + dir + "/mpi_case.csv --noise-bound " +
-                             std::to_string(ex.noise_bound) + " --horizon 1 --order 1 --solver csdp --quiet";
-  ASSERT_EQ(std::system((common + " --json " + dir + "/local.json > /dev/null").c_str()), 0);
+                             std::to_string(ex.noise_bound) + " --horizon 1 --order 1 --solver csdp --quiet" + extra;
+  ASSERT_EQ(std::system((common + " --json " + dir + "/" + name + "_local.json > /dev/null").c_str()), 0);
   const std::string mpi = "mpirun --allow-run-as-root --oversubscribe -np 3 " + common + " --executor mpi --json " +
-                          dir + "/mpi.json > " + dir + "/mpi.log 2>&1";
+                          dir + "/" + name + "_mpi.json > " + dir + "/" + name + "_mpi.log 2>&1";
   const int rc = std::system(mpi.c_str());
-  ASSERT_EQ(rc, 0) << "mpirun failed; see " << dir << "/mpi.log";
+  ASSERT_EQ(rc, 0) << "mpirun failed; see " << dir << "/" << name << "_mpi.log";
   nlohmann::json a, b;
-  std::ifstream(dir + "/local.json") >> a;
-  std::ifstream(dir + "/mpi.json") >> b;
+  std::ifstream(dir + "/" + name + "_local.json") >> a;
+  std::ifstream(dir + "/" + name + "_mpi.json") >> b;
   EXPECT_NE(b.at("executor").get<std::string>().find("mpi (2 workers)"), std::string::npos);
   ASSERT_EQ(a.at("intervals").size(), b.at("intervals").size());
   for (std::size_t i = 0; i < a.at("intervals").size(); ++i)
@@ -151,6 +151,18 @@ TEST(MpiExecutor, SameIntervalsAsTheLocalRun) {
       EXPECT_EQ(a["intervals"][i][side]["status"], b["intervals"][i][side]["status"]);
     }
   EXPECT_EQ(a["counts"]["orthants_proven_empty"], b["counts"]["orthants_proven_empty"]);
+  EXPECT_EQ(a.value("pieces", nlohmann::json::array()).size(), b.value("pieces", nlohmann::json::array()).size());
+}
+
+TEST(MpiExecutor, SameIntervalsAsTheLocalRun) {
+  if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun not installed";
+  ExpectMpiIntervalsEqualTheLocalRun("whole", "");
+}
+
+// A split box runs one MPI session per piece: the worker ranks serve them in turn.
+TEST(MpiExecutor, SplitBoxSameIntervalsAsTheLocalRun) {
+  if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun not installed";
+  ExpectMpiIntervalsEqualTheLocalRun("split", " --split a1=-0.5,1.8");
 }
 #endif
 

@@ -164,6 +164,19 @@ def test_moment_witnesses_switch_as_in_the_cli(recording, tmp_path):
         assert (a["lower"]["value"], a["upper"]["value"]) == (b["lower"]["value"], b["upper"]["value"])
 
 
+def test_split_box_as_in_the_cli(recording, tmp_path):
+    path, rec = recording
+    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--params", "a1",
+            "--solver", "csdp", "--threads", 2, "--split", "a1=-0.5,1.8", "--quiet", "--json", tmp_path / "cli.json")
+    cli = load_json(tmp_path / "cli.json")
+    py = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, parameters=["a1"],
+                         solver="csdp", threads=2, split={"a1": [-0.5, 1.8]}, source=path)
+    assert py["intervals"] == cli["intervals"]
+    assert len(py["pieces"]) == 3
+    assert [p["intervals"] for p in py["pieces"]] == [p["intervals"] for p in cli["pieces"]]
+    assert [p["prior_box"][4]["hi"] for p in py["pieces"]] == [-0.5, 1.8, 10.0]
+
+
 def test_row_block_order_and_endpoint_refinements_as_in_the_cli(recording, tmp_path):
     path, rec = recording
     run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 2, "--params", "a1",

@@ -63,6 +63,10 @@ BOUNDS_CASES = [
     ({"box": (5, 1)}, ["--box", "5,1"], "--box"),
     ({"box": {"a1": (3, -3)}}, ["--box", "a1=3,-3"], "--box"),
     ({"box": {"zz": (0, 1)}}, ["--box", "zz=0,1"], "--box"),
+    # The cuts of a split box: one library check (relax::ValidBoxCuts).
+    ({"split": {"a1": 10}}, ["--split", "a1=10"], "--split"),
+    ({"split": {"zz": 0}}, ["--split", "zz=0"], "--split"),
+    ({"split": {"a1": [1, 1]}}, ["--split", "a1=1,1"], "--split"),
 ]
 
 
