@@ -133,6 +133,44 @@ void AttachWitnessedRanges(const HwOuterSet& set, const std::vector<FeasiblePoin
   }
 }
 
+// Each orthant's status and certificate (screen, then the pipeline's passes), its row reduction and contracted box.
+void ReportOrthants(const HwOuterSet& set, const ScreenResult& screen, const std::vector<OrthantWork>& orthants,
+                    const PassOutcomes& full, const std::vector<int>& wanted_objectives, BoundsSummary& summary) {
+  summary.orthants_total = set.num_orthants();
+  std::vector<std::string> status = screen.status;
+  std::vector<std::optional<EmptinessCertificate>> certificate = screen.certificates;
+  for (const auto& w : orthants) {
+    if (w.empty()) certificate[w.index] = w.certificate;
+    bool failed = false;
+    for (int o : wanted_objectives)
+      if (full.count({w.index, o}) && full.at({w.index, o}).status == "failed") failed = true;
+    status[w.index] = w.empty() ? w.status : failed ? "failed (conservative fallback)" : "solved";
+    summary.row_reduction.push_back({{"orthant", w.index}, {"per_step", w.reduction}});
+    if (!w.empty() && w.box != set.box()) summary.orthant_boxes.push_back({w.index, w.box});
+  }
+  for (int l = 0; l < set.num_orthants(); ++l) {
+    if (status[l].rfind("empty", 0) == 0) ++summary.orthants_empty;
+    else if (status[l].rfind("failed", 0) == 0) ++summary.orthants_failed;
+    else ++summary.orthants_solved;
+    summary.orthants.push_back({l, sign_text(set, l), status[l], certificate[l]});
+  }
+}
+
+// The job counts and times of the run (cached jobs excluded from the times).
+void CopyJobCounters(EngineCounters counters, BoundsSummary& summary) {
+  summary.sdp_jobs = counters.sdp_jobs;
+  summary.sdp_solves = counters.sdp_solves;
+  summary.jobs_from_cache = counters.jobs_from_cache;
+  summary.jobs_stopped_beyond_witness = counters.jobs_stopped_beyond_witness;
+  summary.jobs_settled_by_sign = counters.jobs_settled_by_sign;
+  summary.solve_seconds = counters.solve_seconds;
+  summary.verify_seconds = counters.verify_seconds;
+  summary.largest_moments = counters.largest_moments;
+  summary.largest_blocks = counters.largest_blocks;
+  std::sort(counters.solve_times.begin(), counters.solve_times.end());
+  if (!counters.solve_times.empty()) summary.median_solve_seconds = counters.solve_times[counters.solve_times.size() / 2];
+}
+
 }  // namespace
 
 bool ValidOrder(int order, int horizon, std::string* error) {
@@ -405,41 +443,14 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
   summary.box = set.box();
   summary.parameter_names = set.layout().names;
-  summary.orthants_total = set.num_orthants();
-  std::vector<std::string> status = screen.status;
-  std::vector<std::optional<EmptinessCertificate>> certificate = screen.certificates;
-  for (const auto& w : orthants) {
-    if (w.empty()) certificate[w.index] = w.certificate;
-    bool failed = false;
-    for (int o : wanted_objectives)
-      if (full.count({w.index, o}) && full.at({w.index, o}).status == "failed") failed = true;
-    status[w.index] = w.empty() ? w.status : failed ? "failed (conservative fallback)" : "solved";
-    summary.row_reduction.push_back({{"orthant", w.index}, {"per_step", w.reduction}});
-    if (!w.empty() && w.box != set.box()) summary.orthant_boxes.push_back({w.index, w.box});
-  }
-  for (int l = 0; l < set.num_orthants(); ++l) {
-    if (status[l].rfind("empty", 0) == 0) ++summary.orthants_empty;
-    else if (status[l].rfind("failed", 0) == 0) ++summary.orthants_failed;
-    else ++summary.orthants_solved;
-    summary.orthants.push_back({l, sign_text(set, l), status[l], certificate[l]});
-  }
+  ReportOrthants(set, screen, orthants, full, wanted_objectives, summary);
   summary.edge_witness_solves = edges.local_solves;
   summary.edge_witness_seconds = edges.seconds;
   summary.moment_witness_jobs = from_moments.jobs;
   summary.moment_witness_found = static_cast<int>(from_moments.feasible_points.size());
   summary.moment_witness_seconds = from_moments.seconds;
   for (const auto& [key, r] : edges.settled) summary.edge_witness_settled += r.status == "solved" ? 1 : 0;
-  summary.sdp_jobs = counters.sdp_jobs;
-  summary.sdp_solves = counters.sdp_solves;
-  summary.jobs_from_cache = counters.jobs_from_cache;
-  summary.jobs_stopped_beyond_witness = counters.jobs_stopped_beyond_witness;
-  summary.jobs_settled_by_sign = counters.jobs_settled_by_sign;
-  summary.solve_seconds = counters.solve_seconds;
-  summary.verify_seconds = counters.verify_seconds;
-  summary.largest_moments = counters.largest_moments;
-  summary.largest_blocks = counters.largest_blocks;
-  std::sort(counters.solve_times.begin(), counters.solve_times.end());
-  if (!counters.solve_times.empty()) summary.median_solve_seconds = counters.solve_times[counters.solve_times.size() / 2];
+  CopyJobCounters(counters, summary);
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return summary;
 }
