@@ -7,6 +7,11 @@ guaranteed bound of D^ss(n) of one realisation (SNR, seed, N), so every certifie
 realisation, found by any run, must lie inside it for n <= n'. Each witness is re-certified against the
 recording with the plain-Python Result 1 of check_dss_witness.py (recording from `hwbounds simulate`).
 
+A `hwbounds bounds --split` result (a JSON with "pieces") in a table's folder is read as a run on that table's
+realisation (the folder's tables.json must hold one) at its horizon: the truth inside each interval, each interval
+the hull of its live pieces, the pieces tiling the split's box, and every witness of D^ss(n'), n' >= its horizon,
+of the realisation inside it; the grid lists its relaxation gap beside the table's.
+
 Checks, per table file and per realisation over all files:
   truth inside every outer interval (Property 2); order d+1 inside order d of the same run (Property 3);
   n = 3 inside n = 2 of the same run (Property 4); every inner witness of D^ss(n') inside every outer
@@ -97,6 +102,50 @@ def load_table(path):
     return table
 
 
+def split_files(table_path):
+    """The `hwbounds bounds --split` results (JSON objects with "pieces") beside a tables.json."""
+    found = []
+    for path in sorted(glob.glob(os.path.join(os.path.dirname(table_path), "*.json"))):
+        if os.path.basename(path) == "tables.json":
+            continue
+        try:
+            with open(path) as f:
+                result = json.load(f)
+        except (OSError, ValueError) as e:
+            usage_error(f"{path}: not JSON ({e})")
+        if isinstance(result, dict) and "pieces" in result:
+            found.append((path, result))
+    return found
+
+
+def split_case(where, table, split):
+    """The case of the folder's table that a split result beside it bounds: its realisation at the split's n."""
+    keys = {realisation(c) for c in table["cases"]}
+    if len(keys) != 1:
+        usage_error(f"{where}: a split result needs exactly one realisation in the tables.json beside it, not "
+                    f"{len(keys)}")
+    case = next((c for c in table["cases"] if c["n"] == split["horizon"]), None)
+    if case is None:
+        usage_error(f"{where}: no case with n = {split['horizon']} in the tables.json beside it")
+    return case
+
+
+def pieces_tile(box, pieces):
+    """Whether the pieces' boxes are every combination of one slab per parameter, the slabs tiling `box`."""
+    slabs = []
+    for k, (lo, hi) in enumerate(box):
+        sides = sorted({(p[k][0], p[k][1]) for p in pieces})
+        if sides[0][0] != lo or sides[-1][1] != hi or any(a[1] != b[0] for a, b in zip(sides, sides[1:])):
+            return False
+        slabs.append(sides)
+    combinations = {tuple(tuple(side) for side in p) for p in pieces}
+    return len(combinations) == len(pieces) == math.prod(len(s) for s in slabs)
+
+
+def box_of(result):
+    return [(b["lo"], b["hi"]) for b in result["prior_box"]]
+
+
 def realisation(case):
     """Cases of one realisation share the data: same SNR, seed, N (and so the same noise bound)."""
     return (case["snr_db"], case["seed"], case["samples"])
@@ -155,6 +204,23 @@ class Checker:
                         self.fail(where, case, row["parameter"], f"order-{order} outer [{o['lower']}, {o['upper']}] "
                                   f"not inside n = {n - 1}'s [{s['lower']}, {s['upper']}] (Property 4)")
 
+    def check_split(self, where, case, split):
+        """A --split result: truth inside, each interval the hull of its live pieces, the pieces tiling its box."""
+        live = [p for p in split["pieces"] if not p["invalidated"]]
+        pieces = [box_of(p) for p in split["pieces"]]
+        if not pieces_tile(box_of(split), pieces):
+            self.fail(where, case, "-", "the pieces do not tile the split's prior box")
+        truth = {r["parameter"]: r["truth"] for r in case["rows"]}
+        for i, iv in enumerate(split["intervals"]):
+            p, lo, hi = iv["parameter"], iv["lower"]["value"], iv["upper"]["value"]
+            if not inside(truth[p], lo, hi):
+                self.fail(where, case, p, f"truth {truth[p]} outside the split's [{lo}, {hi}] (Property 2)")
+            if live:
+                hull = (min(q["intervals"][i]["lower"]["value"] for q in live),
+                        max(q["intervals"][i]["upper"]["value"] for q in live))
+                if (lo, hi) != hull:
+                    self.fail(where, case, p, f"the split's [{lo}, {hi}] is not the hull {list(hull)} of its pieces")
+
     def check_inner_endpoints(self, where, case, row, box):
         k = NAMES.index(row["parameter"])
         for side in ("lower", "upper"):
@@ -188,6 +254,22 @@ def check_across_runs(checker, tables):
                             checker.fail(where_o, ocase, orow["parameter"],
                                          f"order-{order} outer [{o['lower']}, {o['upper']}] excludes {value}, the "
                                          f"{parameter} {side} witness of n = {wcase['n']} in {where_w}")
+
+
+def check_splits_against_witnesses(checker, tables, splits):
+    """Every witness of D^ss(n') of the split's realisation, n' >= its n, any run, inside each split interval."""
+    for where_s, case, split in splits:
+        for where_w, table in tables:
+            for wcase in table["cases"]:
+                if realisation(wcase) != realisation(case) or wcase["n"] < case["n"]:
+                    continue
+                for parameter, side, point in witnesses_of(wcase):
+                    for iv in split["intervals"]:
+                        value = point[NAMES.index(iv["parameter"])]
+                        lo, hi = iv["lower"]["value"], iv["upper"]["value"]
+                        if not inside(value, lo, hi):
+                            checker.fail(where_s, case, iv["parameter"], f"the split's [{lo}, {hi}] excludes {value}, "
+                                         f"the {parameter} {side} witness of n = {wcase['n']} in {where_w}")
 
 
 def recording(cli, case, folder, loaded):
@@ -271,6 +353,34 @@ def grid_rows(tables, results_root):
     return [line for _, line in sorted(rows)]
 
 
+def split_rows(splits, results_root):
+    """Per --split result: its cuts, pieces proven empty, and per parameter outer/inner before and after."""
+    lines = []
+    for where, case, split in splits:
+        whole, pieces = box_of(split), [box_of(p) for p in split["pieces"]]
+        cuts = []
+        for k, name in enumerate(NAMES):
+            values = sorted({p[k][1] for p in pieces} - {whole[k][1]})
+            if values:
+                cuts.append(f"{name} = {', '.join(f'{v:g}' for v in values)}")
+        empty = sum(p["invalidated"] for p in split["pieces"])
+        order = str(split["order"])
+        gaps = []
+        for iv in split["intervals"]:
+            row = next(r for r in case["rows"] if r["parameter"] == iv["parameter"])
+            if row.get("inner_reaches_box") or not row.get("inner_found"):
+                gaps.append(f"{iv['parameter']} – (inner hull at the prior box)")
+                continue
+            after = 0.5 * (iv["upper"]["value"] - iv["lower"]["value"]) / row["inner"]["half_width"]
+            before = row["outer"].get(order, {}).get("ratio_outer_inner")
+            gaps.append(f"{iv['parameter']} {before:.2f} → {after:.3f}" if before is not None
+                        else f"{iv['parameter']} {after:.3f}")
+        lines.append(f"| {case['snr_db']:g} | {case['seed']} | {case['samples']} | {case['n']} | {order} | "
+                     f"{'; '.join(cuts)} | {empty} of {len(pieces)} | {'; '.join(gaps)} | "
+                     f"{os.path.relpath(where, results_root)} |")
+    return lines
+
+
 def computed_orders(tables):
     """{(snr, seed, samples): {n: set of orders with outer intervals}} over all runs."""
     seen = {}
@@ -308,7 +418,7 @@ def missing_rows(missing):
             for (snr, seed), cells in missing.items()]
 
 
-def grid_markdown(tables, results_root):
+def grid_markdown(tables, results_root, splits=()):
     seen = computed_orders(tables)
     missing = missing_target_cells(seen)
     total = len(TARGET_SNRS) * len(TARGET_SEEDS) * len(TARGET_HORIZONS) * len(TARGET_ORDERS)
@@ -336,7 +446,12 @@ def grid_markdown(tables, results_root):
         "| SNR dB (realised) | seed | N | n | δ | gap: outer/inner | outer/paper, largest | over the paper by > 1.5 "
         "| endpoints | run |",
         "|---|---|---|---|---|---|---|---|---|---|",
-        *grid_rows(tables, results_root)]) + "\n"
+        *grid_rows(tables, results_root),
+        *(["", "## Box splits (`hwbounds bounds --split`)", "",
+            "Outer/inner half-width per parameter of the split run, against the same realisation's inner hull, "
+            "beside the whole-box run's ratio at that order in the table beside it.", "",
+            "| SNR_w dB | seed | N | n | δ | cut at | pieces proven empty | outer/inner: whole box → split | file |",
+            "|---|---|---|---|---|---|---|---|---|", *split_rows(splits, results_root)] if splits else [])]) + "\n"
 
 
 def main(argv):
@@ -349,14 +464,23 @@ def main(argv):
         for v in table.get("violations", []):
             checker.violations.append(f"{where}: recorded by cerone_tables: {v}")
     check_across_runs(checker, tables)
+    splits = []
+    for where, table in tables:
+        for path, split in split_files(where):
+            case = split_case(path, table, split)
+            checker.check_split(path, case, split)
+            splits.append((path, case, split))
+    check_splits_against_witnesses(checker, tables, splits)
     smallest = recertify_witnesses(checker, tables, args["cli"]) if args["witnesses"] else None
     if args["grid"]:
         root = os.path.commonpath([os.path.dirname(os.path.dirname(os.path.abspath(f))) for f in files])
         with open(args["grid"] + ".part", "w") as out:
-            out.write(grid_markdown([(os.path.abspath(f), t) for f, t in tables], root))
+            out.write(grid_markdown([(os.path.abspath(f), t) for f, t in tables], root,
+                                    [(os.path.abspath(w), c, sp) for w, c, sp in splits]))
         os.replace(args["grid"] + ".part", args["grid"])
     witnesses = sum(1 for _, t in tables for c in t["cases"] for _ in witnesses_of(c))
-    print(f"{len(files)} table files, {sum(len(t['cases']) for _, t in tables)} cases, {witnesses} inner witnesses"
+    print(f"{len(files)} table files, {sum(len(t['cases']) for _, t in tables)} cases, {len(splits)} split runs, "
+          f"{witnesses} inner witnesses"
           + (f" (re-certified; smallest relative slack {smallest:+.3e})" if smallest is not None else ""))
     for v in checker.violations:
         print("VIOLATION " + v)

@@ -94,6 +94,50 @@ def test_a_witness_outside_the_set_fails_recertification(tmp_path):
     assert rc == 1 and "alpha2: inner upper witness outside D^ss(2)" in out, out
 
 
+SPLIT_RUN = "cerone_n2_snr31_delta3_seed3_refined"  # its folder holds a `hwbounds bounds --split gamma2=0` result
+
+
+def broken_split(tmp_path, edit):
+    """A copy of the committed split run's folder with `edit(split)` applied to its split result."""
+    folder = tmp_path / "split"
+    shutil.copytree(os.path.join(RESULTS, SPLIT_RUN), folder)
+    with open(folder / "split_gamma2.json") as f:
+        split = json.load(f)
+    edit(split)
+    (folder / "split_gamma2.json").write_text(json.dumps(split))
+    return folder / "tables.json"
+
+
+def interval(result, parameter):
+    return next(iv for iv in result["intervals"] if iv["parameter"] == parameter)
+
+
+def test_a_split_that_is_not_the_hull_of_its_pieces_is_reported(tmp_path):
+    def edit(split):
+        interval(split, "gamma3")["upper"]["value"] += 0.5
+    rc, out = check(broken_split(tmp_path, edit), "--no-witnesses")
+    assert rc == 1 and "gamma3: the split's [" in out and "is not the hull" in out, out
+
+
+def test_split_pieces_that_do_not_tile_its_box_are_reported(tmp_path):
+    def edit(split):
+        del split["pieces"][0]  # the half gamma2 < 0, proven empty
+    rc, out = check(broken_split(tmp_path, edit), "--no-witnesses")
+    assert rc == 1 and "the pieces do not tile the split's prior box" in out, out
+
+
+def test_a_split_excluding_a_witness_of_the_realisation_is_reported(tmp_path):
+    with open(os.path.join(RESULTS, SPLIT_RUN, "tables.json")) as f:
+        inner_upper = row(json.load(f), 2, "gamma3")["inner"]["upper"]
+
+    def edit(split):  # the split and its live piece both end below the highest gamma3 witness
+        for result in [split] + [p for p in split["pieces"] if not p["invalidated"]]:
+            interval(result, "gamma3")["upper"]["value"] = inner_upper - 1e-3
+    rc, out = check(broken_split(tmp_path, edit), "--no-witnesses")
+    assert rc == 1 and "gamma3: the split's [" in out and "excludes" in out and "upper witness of n = 2" in out, out
+    assert "is not the hull" not in out, out
+
+
 def test_bad_usage_is_an_error_naming_the_fix(tmp_path):
     rc, out = check("--grids", tmp_path)
     assert rc == 2 and "unknown option '--grids'" in out and "--grid OUT.md" in out, out
