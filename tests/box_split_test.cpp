@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
@@ -128,6 +129,29 @@ TEST(ComputeBoundsInPieces, TheHullContainsTheTruthAndAnEmptyPieceDropsOut) {
   EXPECT_GE(split.intervals[a1].lower.value, -0.5);
   EXPECT_EQ(split.orthants_empty, whole.orthants_empty);
   EXPECT_THROW(ComputeBoundsInPieces(options, set, {{"a1", {10.0}}}), InputError);
+}
+
+// Each piece keeps its jobs in the run directory under its own box: a rerun reads every piece back and gives the
+// same numbers without a solve.
+TEST(ComputeBoundsInPieces, ARerunReadsEveryPieceBackFromTheRunDirectory) {
+  const HwOuterSet set = SeededSet(4, 60, 1, 31.0);
+  BoundsOptions options;
+  options.order = 1;
+  options.parameters = {"a1", "a2"};
+  options.run_dir = ::testing::TempDir() + "/box_split_resume";
+  std::filesystem::remove_all(options.run_dir);
+  options.executor = std::make_shared<sdp::ForkExecutor>(2);
+  const std::vector<BoxCut> cuts = {{"a2", {0.5}}};
+  const auto first = ComputeBoundsInPieces(options, set, cuts);
+  const auto again = ComputeBoundsInPieces(options, set, cuts);
+  EXPECT_GT(first.sdp_jobs, 0);
+  EXPECT_EQ(again.sdp_jobs, 0);
+  EXPECT_GT(again.jobs_from_cache, 0);
+  ASSERT_EQ(first.intervals.size(), again.intervals.size());
+  for (std::size_t i = 0; i < first.intervals.size(); ++i) {
+    EXPECT_EQ(first.intervals[i].lower.value, again.intervals[i].lower.value) << first.intervals[i].name;
+    EXPECT_EQ(first.intervals[i].upper.value, again.intervals[i].upper.value) << first.intervals[i].name;
+  }
 }
 
 }  // namespace
