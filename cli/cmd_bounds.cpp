@@ -44,7 +44,21 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
   return box;
 }
 
-std::vector<double> parse_list(const std::string& text, const std::string& what);
+std::vector<double> parse_list(const std::string& text, const std::string& what) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    try {
+      v.push_back(std::stod(item, &used));
+    } catch (...) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) throw InputError(fmt::format("{}: '{}' is not a number", what, item));
+  }
+  return v;
+}
 
 // "--split gamma2=0" or "--split a1=1.7,1.8 --split b1=0": the prior box is cut at these values (one entry per
 // parameter). The text's syntax is checked here, the values against the box by the library's ValidBoxCuts.
@@ -57,20 +71,6 @@ std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
     cuts.push_back({spec.substr(0, eq), parse_list(spec.substr(eq + 1), fmt::format("--split '{}'", spec))});
   }
   return cuts;
-}
-
-std::vector<double> parse_list(const std::string& text, const std::string& what) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      v.push_back(std::stod(item));
-    } catch (...) {
-      throw InputError(fmt::format("{}: '{}' is not a number", what, item));
-    }
-  }
-  return v;
 }
 
 // Exit status of a run whose data prove that no parameter in the prior box fits (README, `bounds --help`).

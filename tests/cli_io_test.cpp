@@ -69,6 +69,7 @@ TEST_F(CliIo, BadSplitIsNamedBeforeAnyWork) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"--split a1", "expected NAME=VALUE[,VALUE...]"},
       {"--split a1=x", "'x' is not a number"},
+      {"--split a1=0.5x", "'0.5x' is not a number"},
       {"--split a7=0", "no parameter 'a7'"},
       {"--split a1=10", "not strictly inside its prior box side [-10, 10]"},
       {"--box a1=0,3 --split a1=-1", "not strictly inside its prior box side [0, 3]"},
