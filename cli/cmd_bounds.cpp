@@ -262,6 +262,20 @@ void PrintPieces(const relax::BoundsSummary& summary) {
   }
 }
 
+// Where the relaxation may overestimate most: the largest part of an interval no certified point reaches, from
+// 10 % of its width on, with the cut that bounds that part on its own.
+void PrintUnwitnessedPart(const relax::BoundsSummary& summary) {
+  const auto part = relax::LargestUnwitnessedPart(summary);
+  if (!part || part->fraction < 0.1) return;
+  fmt::print("\nlargest unwitnessed part: no certified feasible point has {} in {} ({:.0f}% of its interval); the "
+             "relaxation may overestimate there. A cut just {} {:.6g} (--split {}=VALUE) bounds that part on its own "
+             "and may prove it empty (README, \"Box split\").\n",
+             part->parameter,
+             part->below ? fmt::format("[{:.6g}, {:.6g})", part->bound, part->witnessed)
+                         : fmt::format("({:.6g}, {:.6g}]", part->witnessed, part->bound),
+             100 * part->fraction, part->below ? "below" : "above", part->witnessed, part->parameter);
+}
+
 void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std::string>& names, bool verify) {
   fmt::print("\nprior box (assumption): ");
   for (std::size_t i = 0; i < names.size(); ++i)
@@ -477,6 +491,7 @@ void AddBoundsCommand(CLI::App& app) {
     PrintPieces(summary);
     PrintRunSummary(summary, names, !o->no_verify);
     if (!invalidated) PrintWarnings(summary, !o->no_verify);
+    PrintUnwitnessedPart(summary);
     if (!o->json_out.empty()) {
       write_text_atomic(o->json_out, ResultJson(summary, *o, set, truth, covered).dump(2) + "\n");
       fmt::print("wrote {}\n", o->json_out);

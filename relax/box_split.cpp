@@ -215,6 +215,23 @@ BoundsSummary CombinePieces(const std::vector<BoundsSummary>& pieces, const Para
   return out;
 }
 
+std::optional<UnwitnessedPart> LargestUnwitnessedPart(const BoundsSummary& summary) {
+  std::optional<UnwitnessedPart> largest;
+  if (summary.invalidated()) return largest;
+  for (const auto& iv : summary.intervals) {
+    const double width = iv.upper.value - iv.lower.value;
+    if (!iv.witnessed_lower || !iv.witnessed_upper || !(width > 0)) continue;
+    for (const bool below : {true, false}) {
+      const UnwitnessedPart part{iv.name, below, below ? iv.lower.value : iv.upper.value,
+                                 below ? *iv.witnessed_lower : *iv.witnessed_upper,
+                                 (below ? *iv.witnessed_lower - iv.lower.value : iv.upper.value - *iv.witnessed_upper) /
+                                     width};
+      if (!largest || part.fraction > largest->fraction) largest = part;
+    }
+  }
+  return largest;
+}
+
 BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterSet& set,
                                     const std::vector<BoxCut>& cuts,
                                     const std::function<void(const BoundsProgress&)>& progress) {

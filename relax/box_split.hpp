@@ -8,6 +8,7 @@
 // where the certified feasible points of a parameter end and its outer interval goes on (the "witnessed" range
 // of a first run).
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,6 +41,19 @@ std::vector<ParameterBox> BoxPieces(const ParameterBox& box, const std::vector<B
 // "pieces", verified when each piece's certificate is). Counts and times are sums, the median solve time the
 // median of the pieces' medians; `box` is the union's box. Each piece's own JSON is kept in `pieces`.
 BoundsSummary CombinePieces(const std::vector<BoundsSummary>& pieces, const ParameterBox& box);
+
+// The side of an interval with the largest part that no certified feasible point reaches: [lower, witnessed_lower)
+// or (witnessed_upper, upper], as a fraction of the interval's width. Where a relaxation overestimates most, a cut
+// of the box just outside the witnessed value often lets it prove that part empty. Absent when no interval has a
+// witnessed range or a positive width.
+struct UnwitnessedPart {
+  std::string parameter;
+  bool below = true;        // the part lies below the witnessed range (else above it)
+  double bound = 0.0;       // the interval's endpoint on that side
+  double witnessed = 0.0;   // the witnessed range's end on that side
+  double fraction = 0.0;    // |witnessed - bound| / (upper - lower)
+};
+std::optional<UnwitnessedPart> LargestUnwitnessedPart(const BoundsSummary& summary);
 
 // ComputeBounds in each piece of set.box() (same options, run cache and executor; each piece resumes on its
 // own), combined by CombinePieces. Progress phases start with "piece k of K: ". No cut: ComputeBounds itself.

@@ -109,6 +109,23 @@ TEST(CombinePieces, EveryPieceEmptyInvalidatesTheModelWithAVerifiedCertificateOn
   EXPECT_FALSE(weak.orthants[0].certificate->verified);
 }
 
+TEST(LargestUnwitnessedPart, TheWidestSideNoCertifiedPointReaches) {
+  BoundsSummary s = Piece(-1.0, 3.0, "solved");
+  EXPECT_FALSE(LargestUnwitnessedPart(s)) << "no witnessed range, no part";
+  s.intervals[0].witnessed_lower = 0.0;  // [-1, 0) unwitnessed: 25 % of the width 4
+  s.intervals[0].witnessed_upper = 2.5;  // (2.5, 3] unwitnessed: 12.5 %
+  const auto part = LargestUnwitnessedPart(s);
+  ASSERT_TRUE(part);
+  EXPECT_EQ(part->parameter, "p");
+  EXPECT_TRUE(part->below);
+  EXPECT_EQ(part->bound, -1.0);
+  EXPECT_EQ(part->witnessed, 0.0);
+  EXPECT_DOUBLE_EQ(part->fraction, 0.25);
+  s.intervals[0].witnessed_upper = 1.0;  // now the upper side is the larger: (1, 3], 50 %
+  EXPECT_FALSE(LargestUnwitnessedPart(s)->below);
+  EXPECT_DOUBLE_EQ(LargestUnwitnessedPart(s)->fraction, 0.5);
+}
+
 // End to end on the paper's example (N = 60, n = 1, order 1: seconds): a cut at the truth of a1 and one at
 // a1 = -0.5, below every point of D^ss(1) here, whose piece the engine proves empty.
 TEST(ComputeBoundsInPieces, TheHullContainsTheTruthAndAnEmptyPieceDropsOut) {
@@ -127,6 +144,8 @@ TEST(ComputeBoundsInPieces, TheHullContainsTheTruthAndAnEmptyPieceDropsOut) {
   });
   const std::size_t a1 = ParameterIndex(split, "a1");
   EXPECT_GE(split.intervals[a1].lower.value, -0.5);
+  // Each piece's relaxation is tighter than the whole box's: a1's upper endpoint 9.96 -> 9.92 here.
+  EXPECT_LT(split.intervals[a1].upper.value, whole.intervals[a1].upper.value - 0.01);
   EXPECT_EQ(split.orthants_empty, whole.orthants_empty);
   EXPECT_THROW(ComputeBoundsInPieces(options, set, {{"a1", {10.0}}}), InputError);
 }
