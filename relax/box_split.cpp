@@ -6,6 +6,7 @@
 #include <set>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/csv_table.hpp"
 
@@ -34,19 +35,12 @@ std::vector<std::pair<double, double>> Slabs(std::pair<double, double> side, std
   return slabs;
 }
 
-std::string JoinedNames(const std::vector<std::string>& names) {
-  std::string all;
-  for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
-  return all;
-}
-
 // The outermost endpoint over the live pieces (dir -1: lower, +1: upper), with the weakest status of them.
 Endpoint OutermostEndpoint(const std::vector<const Endpoint*>& endpoints, const std::vector<int>& piece_of, int dir) {
-  Endpoint out;
   std::size_t best = 0;
   for (std::size_t i = 1; i < endpoints.size(); ++i)
     if (dir < 0 ? endpoints[i]->value < endpoints[best]->value : endpoints[i]->value > endpoints[best]->value) best = i;
-  out = *endpoints[best];
+  Endpoint out = *endpoints[best];
   if (!out.note.empty()) out.note = fmt::format("piece {}: {}", piece_of[best] + 1, out.note);
   bool all_verified = true, any_unverified = false;
   for (const Endpoint* e : endpoints) {
@@ -122,7 +116,7 @@ bool ValidBoxCuts(const std::vector<BoxCut>& cuts, const std::vector<std::string
   for (const auto& cut : cuts) {
     const std::size_t k = IndexOf(names, cut.parameter);
     if (k >= names.size() || k >= box.size())
-      return Fail(error, fmt::format("split: no parameter '{}'; the parameters are: {}", cut.parameter, JoinedNames(names)));
+      return Fail(error, fmt::format("split: no parameter '{}'; the parameters are: {}", cut.parameter, fmt::join(names, ", ")));
     if (!seen.insert(cut.parameter).second)
       return Fail(error, fmt::format("split: '{}' is cut twice; give all its cut points in one entry, e.g. {}=V1,V2",
                                      cut.parameter, cut.parameter));
@@ -177,9 +171,7 @@ BoundsSummary CombinePieces(const std::vector<BoundsSummary>& pieces, const Para
     AddCounts(p, out);
     medians.push_back(p.median_solve_seconds);
     out.feasible_points.insert(out.feasible_points.end(), p.feasible_points.begin(), p.feasible_points.end());
-    nlohmann::json j = p.to_json();
-    j["invalidated"] = p.invalidated();
-    out.pieces.push_back(std::move(j));
+    out.pieces.push_back(p.to_json());  // with its own "invalidated" and "prior_box"
   }
   std::sort(medians.begin(), medians.end());
   out.median_solve_seconds = medians[medians.size() / 2];
