@@ -88,6 +88,7 @@ struct BoundsCliOptions {
   int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
   int endpoint_refinements = 0;
   int row_block_order = -1;
+  int auto_split = 0;
 };
 
 relax::HwData ReadData(const BoundsCliOptions& o) {
@@ -135,6 +136,7 @@ void CheckBoundsOptions(const BoundsCliOptions& o) {
                 [&](std::string* e) { return relax::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
   RequireOption("--endpoint-refinements",
                 [&](std::string* e) { return relax::ValidEndpointRefinements(o.endpoint_refinements, e); });
+  RequireOption("--auto-split", [&](std::string* e) { return relax::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
@@ -247,7 +249,7 @@ void PrintPieces(const relax::BoundsSummary& summary) {
     const auto& box = piece.at("prior_box");
     for (std::size_t i = 0; i < box.size() && i < summary.box.size(); ++i)
       if (box[i].at("lo").get<double>() != summary.box[i].first || box[i].at("hi").get<double>() != summary.box[i].second)
-        sides += fmt::format("{}{} in [{}, {}]", sides.empty() ? "" : ", ", box[i].at("parameter").get<std::string>(),
+        sides += fmt::format("{}{} in [{:.6g}, {:.6g}]", sides.empty() ? "" : ", ", box[i].at("parameter").get<std::string>(),
                              box[i].at("lo").get<double>(), box[i].at("hi").get<double>());
     std::string result;
     if (piece.at("invalidated").get<bool>()) {
@@ -259,6 +261,32 @@ void PrintPieces(const relax::BoundsSummary& summary) {
     }
     fmt::print("  piece {} ({}): {}; wall {:.1f} s\n", k + 1, sides, result,
                piece.at("timing").at("wall_seconds").get<double>());
+  }
+}
+
+// One line per automatic round: the cut it added, the box it ran in (the sides the earlier rounds proved), and
+// what it gave.
+void PrintAutoSplitRounds(const relax::BoundsSummary& summary) {
+  if (summary.auto_split.is_null()) return;
+  const auto& rounds = summary.auto_split.at("rounds");
+  fmt::print("\nautomatic cuts: {} round(s) after the first run ({}); each bounds D^ss(n) in the prior box, the "
+             "last one's intervals are those above:\n",
+             rounds.size() - 1, summary.auto_split.at("stopped").get<std::string>());
+  for (const auto& round : rounds) {
+    const auto& cut = round.at("cut");
+    std::string what = cut.is_null() ? std::string("first run")
+                                     : fmt::format("cut {} = {:.6g} ({:.0f}% of its interval unwitnessed)",
+                                                   cut.at("parameter").get<std::string>(), cut.at("value").get<double>(),
+                                                   100 * cut.at("unwitnessed_fraction").get<double>());
+    std::string intervals;
+    for (const auto& iv : round.at("intervals"))
+      intervals += fmt::format("{}{} [{:.6f}, {:.6f}]", intervals.empty() ? "" : ", ",
+                               iv.at("parameter").get<std::string>(), iv.at("lower").get<double>(),
+                               iv.at("upper").get<double>());
+    fmt::print("  round {} ({}, {} piece(s)): {}; wall {:.1f} s\n", round.at("round").get<int>(), what,
+               round.at("pieces").get<std::size_t>(),
+               round.at("invalidated").get<bool>() ? std::string("every orthant proven empty") : intervals,
+               round.at("wall_seconds").get<double>());
   }
 }
 
@@ -401,6 +429,10 @@ void AddBoundsCommand(CLI::App& app) {
                   "cut the prior box at these values of one parameter, NAME=VALUE[,VALUE...] (repeat for more "
                   "parameters): each piece is bounded on its own and the intervals are the hull over the pieces, "
                   "often tighter (README, \"The relaxation gap\")");
+  cmd->add_option("--auto-split", o->auto_split,
+                  "after the run, up to this many rounds (0..5): shrink the box to the verified intervals, cut off "
+                  "the largest part of an interval no certified feasible point reaches (from 10% of its width) just "
+                  "beyond that point, and bound again over the pieces (README, \"Box split\")");
   cmd->add_option("--solver", o->solver,
                   fmt::format("SDP backend: auto (CSDP, measured fastest at orders 2 and 3; docs/sdp.md), {}",
                               fmt::join(sdp::AvailableSolvers(), ", ")));
@@ -458,7 +490,7 @@ void AddBoundsCommand(CLI::App& app) {
     RequireOption("--split", [&](std::string* e) { return relax::ValidBoxCuts(cuts, names, set.box(), e); });
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
-      relax::ComputeBoundsInPieces(options, set, cuts);
+      relax::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
       return;
     }
     std::vector<double> truth;
@@ -483,12 +515,15 @@ void AddBoundsCommand(CLI::App& app) {
                  p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
                  p.elapsed_seconds, p.eta_seconds);
     };
-    const auto summary = relax::ComputeBoundsInPieces(options, set, cuts, progress);
+    relax::AutoSplitOptions auto_split;
+    auto_split.rounds = o->auto_split;
+    const auto summary = relax::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split, progress);
     const bool invalidated = summary.invalidated();
     bool covered = true;
     if (invalidated) PrintInvalidation(summary, *o);
     else covered = PrintIntervals(summary, names, truth);
     PrintPieces(summary);
+    PrintAutoSplitRounds(summary);
     PrintRunSummary(summary, names, !o->no_verify);
     if (!invalidated) PrintWarnings(summary, !o->no_verify);
     PrintUnwitnessedPart(summary);

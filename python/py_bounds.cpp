@@ -97,6 +97,7 @@ struct BoundsArgs {
   int horizon = 2;
   bool order_given = false;  // false: the minimal order of the horizon
   relax::BoundsOptions options;
+  relax::AutoSplitOptions auto_split;
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
@@ -121,6 +122,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   Require([&](std::string* e) { return relax::ValidBlockOrderCap(a.options.generation.block_order_cap, e); });
   Require([&](std::string* e) { return relax::ValidStoppedShortRefinements(a.options.stopped_short_refinements, e); });
   Require([&](std::string* e) { return relax::ValidEndpointRefinements(a.options.endpoint_refinements, e); });
+  Require([&](std::string* e) { return relax::ValidAutoSplitRounds(a.auto_split.rounds, a.executor, e); });
   if (a.executor == "mpi")
     throw py::value_error(
         "executor 'mpi' runs under mpirun from the CLI (`hwbounds bounds --executor mpi`); use "
@@ -137,7 +139,9 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (!progress.is_none()) progress(ProgressDict(p));
   };
-  const auto summary = WithoutGil([&] { return relax::ComputeBoundsInPieces(a.options, set, cuts, report); });
+  const auto summary = WithoutGil([&] {
+    return relax::ComputeBoundsWithAutoSplit(a.options, set, cuts, a.auto_split, report);
+  });
   nlohmann::json j = summary.to_json();
   j["data"] = source;
   j["data_warnings"] = set.warnings();  // as the CLI writes them
@@ -159,7 +163,7 @@ void DefineBounds(py::module_& m) {
       "bounds",
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
          std::string output_basis, int horizon, py::object order, bool strictly_proper, py::handle box, py::handle split,
-         std::string solver,
+         int auto_split, std::string solver,
          int threads, std::string executor, std::string run_dir, std::vector<std::string> parameters, bool cheap_pass,
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
@@ -173,6 +177,7 @@ void DefineBounds(py::module_& m) {
         a.output_basis = std::move(output_basis);
         a.horizon = horizon;
         a.executor = std::move(executor);
+        a.auto_split.rounds = auto_split;
         auto& op = a.options;
         // None = the minimal order ceil((n + 1) / 2) (at least 1), as the CLI's default "--order minimal".
         a.order_given = !order.is_none();
@@ -207,6 +212,9 @@ mixed relaxation with 9x9 data-row blocks).
 box: None (every parameter in [-10, 10]), (lo, hi), {name: (lo, hi)} or one pair per parameter.
 split: None or {name: value or [values]}, the CLI's --split: the box is cut there, each piece bounded on its own,
 and the intervals are the hull over the pieces (each piece's own result under "pieces").
+auto_split: the CLI's --auto-split, 0..5 rounds: after the run, the box shrunk to the verified intervals is cut
+just beyond the last certified feasible point of the largest unwitnessed part and bounded again (each round's
+box, cut and intervals under "auto_split").
 progress: called as progress(dict(phase, done, total, from_cache, elapsed_seconds, eta_seconds)) after each job
 (done/total count the jobs still to run; from_cache those read from run_dir).
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
@@ -215,7 +223,8 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
       py::arg("input_basis") = "poly:3", py::arg("output_basis") = "poly:3", py::arg("horizon") = 2,
       py::arg("order") = py::none(), py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
-      py::arg("box") = py::none(), py::arg("split") = py::none(), py::arg("solver") = o.solver, py::arg("threads") = o.threads,
+      py::arg("box") = py::none(), py::arg("split") = py::none(),
+      py::arg("auto_split") = 0, py::arg("solver") = o.solver, py::arg("threads") = o.threads,
       py::arg("executor") = "fork", py::arg("run_dir") = o.run_dir, py::arg("parameters") = o.parameters,
       py::arg("cheap_pass") = o.cheap_pass, py::arg("edge_witnesses") = o.edge_witness.enabled,
       py::arg("moment_witnesses") = o.moment_witnesses,

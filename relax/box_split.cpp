@@ -108,6 +108,41 @@ OrthantReport CombinedOrthant(const std::vector<BoundsSummary>& pieces, std::siz
   return r;
 }
 
+// A round of ComputeBoundsWithAutoSplit as JSON: its box, the cut it added (none for the first run) and what it
+// gave.
+nlohmann::json RoundJson(int round, const ParameterBox& box, const std::optional<UnwitnessedPart>& part, double cut,
+                         const BoundsSummary& s) {
+  nlohmann::json j;
+  j["round"] = round;
+  for (std::size_t i = 0; i < box.size(); ++i)
+    j["box"].push_back({{"parameter", s.parameter_names[i]}, {"lo", box[i].first}, {"hi", box[i].second}});
+  j["cut"] = part ? nlohmann::json{{"parameter", part->parameter}, {"value", cut}, {"unwitnessed_fraction", part->fraction}}
+                  : nlohmann::json(nullptr);
+  j["pieces"] = std::max<std::size_t>(1, s.pieces.size());
+  j["invalidated"] = s.invalidated();
+  j["intervals"] = nlohmann::json::array();
+  if (!s.invalidated())
+    for (const auto& iv : s.intervals)
+      j["intervals"].push_back({{"parameter", iv.name}, {"lower", iv.lower.value}, {"upper", iv.upper.value}});
+  j["sdp_solves"] = s.sdp_solves;
+  j["wall_seconds"] = s.wall_seconds;
+  return j;
+}
+
+// The witnessed ranges and feasible points of `earlier` carried into `later` (both bound D^ss(n) in one box, and
+// a certified point stays certified).
+void KeepWitnesses(const BoundsSummary& earlier, BoundsSummary& later) {
+  later.feasible_points.insert(later.feasible_points.begin(), earlier.feasible_points.begin(),
+                               earlier.feasible_points.end());
+  if (earlier.invalidated() || later.invalidated()) return;
+  for (auto& iv : later.intervals)
+    for (const auto& e : earlier.intervals) {
+      if (e.name != iv.name) continue;
+      if (e.witnessed_lower) iv.witnessed_lower = std::min(iv.witnessed_lower.value_or(*e.witnessed_lower), *e.witnessed_lower);
+      if (e.witnessed_upper) iv.witnessed_upper = std::max(iv.witnessed_upper.value_or(*e.witnessed_upper), *e.witnessed_upper);
+    }
+}
+
 }  // namespace
 
 bool ValidBoxCuts(const std::vector<BoxCut>& cuts, const std::vector<std::string>& names, const ParameterBox& box,
@@ -224,6 +259,62 @@ std::optional<UnwitnessedPart> LargestUnwitnessedPart(const BoundsSummary& summa
   return largest;
 }
 
+ParameterBox ProvenBox(const BoundsSummary& summary, const ParameterBox& box) {
+  ParameterBox proven = box;
+  if (summary.invalidated()) return proven;
+  for (const auto& iv : summary.intervals) {
+    const std::size_t k = IndexOf(summary.parameter_names, iv.name);
+    if (k >= proven.size()) continue;
+    auto side = proven[k];
+    if (iv.lower.verification == "verified") side.first = std::max(side.first, iv.lower.value);
+    if (iv.upper.verification == "verified") side.second = std::min(side.second, iv.upper.value);
+    if (side.first < side.second) proven[k] = side;  // a point interval keeps its box side: no empty box side
+  }
+  return proven;
+}
+
+bool ValidAutoSplitRounds(int rounds, const std::string& executor, std::string* error) {
+  if (rounds < 0 || rounds > 5) return Fail(error, fmt::format("auto split: {} rounds; expected 0 (off) to 5", rounds));
+  if (rounds > 0 && executor == "mpi")
+    return Fail(error, "auto split: not under the mpi executor (its worker ranks cannot follow the cuts the "
+                       "coordinator chooses); use the fork executor, or give the cuts as a split");
+  return true;
+}
+
+bool AutoSplitOptions::IsValid(std::string* error) const {
+  if (!ValidAutoSplitRounds(rounds, "", error)) return false;
+  if (!(min_fraction > 0 && min_fraction < 1))
+    return Fail(error, fmt::format("auto split: min_fraction {} is not in (0, 1)", min_fraction));
+  if (!(margin >= 0 && margin < min_fraction))
+    return Fail(error, fmt::format("auto split: margin {} is not in [0, min_fraction = {})", margin, min_fraction));
+  return true;
+}
+
+double CutBeyondWitness(const UnwitnessedPart& part, const BoundsSummary& summary, double margin) {
+  for (const auto& iv : summary.intervals)
+    if (iv.name == part.parameter) {
+      const double step = margin * (iv.upper.value - iv.lower.value);
+      return part.below ? part.witnessed - step : part.witnessed + step;
+    }
+  throw std::logic_error("CutBeyondWitness: no interval of " + part.parameter);
+}
+
+std::vector<BoxCut> WithCut(std::vector<BoxCut> cuts, const std::string& parameter, double value,
+                            const ParameterBox& box, const std::vector<std::string>& names) {
+  auto it = std::find_if(cuts.begin(), cuts.end(), [&](const BoxCut& c) { return c.parameter == parameter; });
+  if (it == cuts.end()) {
+    cuts.push_back({parameter, {}});
+    it = cuts.end() - 1;
+  }
+  if (std::find(it->values.begin(), it->values.end(), value) == it->values.end()) it->values.push_back(value);
+  for (auto& cut : cuts) {
+    const auto side = box[IndexOf(names, cut.parameter)];
+    std::erase_if(cut.values, [&](double v) { return !(v > side.first && v < side.second); });
+  }
+  std::erase_if(cuts, [](const BoxCut& c) { return c.values.empty(); });
+  return cuts;
+}
+
 BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterSet& set,
                                     const std::vector<BoxCut>& cuts,
                                     const std::function<void(const BoundsProgress&)>& progress) {
@@ -247,6 +338,67 @@ BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterS
   BoundsSummary combined = CombinePieces(pieces, set.box());
   combined.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return combined;
+}
+
+BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwOuterSet& set,
+                                         const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
+                                         const std::function<void(const BoundsProgress&)>& progress) {
+  std::string error;
+  if (!auto_split.IsValid(&error)) throw InputError(error);
+  if (!ValidAutoSplitRounds(auto_split.rounds, options.executor ? options.executor->name() : "", &error))
+    throw InputError(error);
+  if (auto_split.rounds == 0) return ComputeBoundsInPieces(options, set, cuts, progress);
+  const std::vector<std::string>& names = set.layout().names;
+  auto round_progress = [&](int round) {
+    return [&progress, round](const BoundsProgress& p) {
+      if (!progress) return;
+      BoundsProgress q = p;
+      if (round > 0) q.phase = fmt::format("auto split round {}: {}", round, p.phase);
+      progress(q);
+    };
+  };
+  ParameterBox box = set.box();
+  std::vector<BoxCut> round_cuts = cuts;
+  BoundsSummary result = ComputeBoundsInPieces(options, set, round_cuts, round_progress(0));
+  nlohmann::json rounds = nlohmann::json::array({RoundJson(0, box, std::nullopt, 0.0, result)});
+  std::string stopped = fmt::format("the {} round(s) asked for ran", auto_split.rounds);
+  std::vector<BoundsSummary> earlier;
+  for (int round = 1; round <= auto_split.rounds; ++round) {
+    if (result.invalidated()) {
+      stopped = "every orthant is proven empty";
+      break;
+    }
+    const auto part = LargestUnwitnessedPart(result);
+    if (!part) {
+      stopped = "no interval has a range of certified feasible points to cut beyond";
+      break;
+    }
+    if (part->fraction < auto_split.min_fraction) {
+      stopped = fmt::format("the largest unwitnessed part ({}, {:.1f}% of its interval) is under {:.0f}%",
+                            part->parameter, 100 * part->fraction, 100 * auto_split.min_fraction);
+      break;
+    }
+    const double cut = CutBeyondWitness(*part, result, auto_split.margin);
+    const ParameterBox proven = ProvenBox(result, box);
+    std::vector<BoxCut> next_cuts = WithCut(round_cuts, part->parameter, cut, proven, names);
+    if (proven == box && next_cuts.size() == round_cuts.size() &&
+        std::equal(next_cuts.begin(), next_cuts.end(), round_cuts.begin(),
+                   [](const BoxCut& a, const BoxCut& b) { return a.parameter == b.parameter && a.values == b.values; })) {
+      stopped = fmt::format("the next cut ({} = {:.6g}) is in place and the box did not shrink", part->parameter, cut);
+      break;
+    }
+    BoundsSummary next = ComputeBoundsInPieces(options, set.WithBox(proven), next_cuts, round_progress(round));
+    KeepWitnesses(result, next);
+    rounds.push_back(RoundJson(round, proven, part, cut, next));
+    earlier.push_back(std::move(result));
+    result = std::move(next);
+    box = proven;
+    round_cuts = std::move(next_cuts);
+  }
+  for (const auto& e : earlier) AddCounts(e, result);
+  result.box = set.box();
+  result.auto_split = {{"rounds", std::move(rounds)}, {"stopped", stopped}};
+  return result;
 }
 
 }  // namespace hw::relax

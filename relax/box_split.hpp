@@ -55,10 +55,45 @@ struct UnwitnessedPart {
 };
 std::optional<UnwitnessedPart> LargestUnwitnessedPart(const BoundsSummary& summary);
 
+// The box a result proves to hold every point of D^ss(n) in `box`: each side of a computed interval whose endpoint
+// is verified in interval arithmetic (any other side stays as in `box`).
+ParameterBox ProvenBox(const BoundsSummary& summary, const ParameterBox& box);
+
+// Automatic cuts (ComputeBoundsWithAutoSplit): after the run, up to `rounds` times, shrink the box to the
+// proven intervals and cut off the largest unwitnessed part just beyond its last certified feasible point.
+struct AutoSplitOptions {
+  int rounds = 0;              // 0: no automatic cut
+  double min_fraction = 0.1;   // a part under this share of its interval is not cut off (the CLI's hint threshold)
+  double margin = 0.02;        // the cut lies this share of the interval's width beyond the witnessed value, so
+                               // the cut-off piece holds no certified point and can be proven empty
+  bool IsValid(std::string* error) const;
+};
+// Automatic rounds: 0..5 (each round is a full run over the pieces of the shrunk box), and none under the executor
+// "mpi", whose worker ranks cannot follow the cuts the coordinator chooses.
+bool ValidAutoSplitRounds(int rounds, const std::string& executor, std::string* error);
+
+// The cut that bounds `part` on its own: `margin` x the interval's width beyond its witnessed end.
+double CutBeyondWitness(const UnwitnessedPart& part, const BoundsSummary& summary, double margin);
+
+// `cuts` with `value` added to the cut points of `parameter`, dropping every cut point that is not strictly inside
+// `box` (a shrunk box can leave an earlier cut outside). Unchanged when `value` is already a cut point.
+std::vector<BoxCut> WithCut(std::vector<BoxCut> cuts, const std::string& parameter, double value,
+                            const ParameterBox& box, const std::vector<std::string>& names);
+
 // ComputeBounds in each piece of set.box() (same options, run cache and executor; each piece resumes on its
 // own), combined by CombinePieces. Progress phases start with "piece k of K: ". No cut: ComputeBounds itself.
 BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterSet& set,
                                     const std::vector<BoxCut>& cuts,
                                     const std::function<void(const BoundsProgress&)>& progress = {});
+
+// ComputeBoundsInPieces, then AutoSplitOptions::rounds rounds, each a run over the pieces of ProvenBox(last result)
+// cut at the previous cuts and at CutBeyondWitness(LargestUnwitnessedPart); the rounds stop early when no part
+// reaches min_fraction or its cut is already there. Each round bounds D^ss(n) in set.box(), so its intervals are
+// valid and lie inside the previous round's. The result is the last round's, with set.box() as its box, every
+// round's feasible points and witnessed ranges, counts and times summed over the rounds, and each round's box, cut
+// and intervals in `auto_split`. Not under an MPI executor (its worker ranks cannot follow the coordinator's cuts).
+BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwOuterSet& set,
+                                         const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
+                                         const std::function<void(const BoundsProgress&)>& progress = {});
 
 }  // namespace hw::relax

@@ -317,6 +317,7 @@ nlohmann::json BoundsSummary::to_json() const {
   j["bound_sources"] = bound_sources;
   j["clipped_to_prior_box"] = clipped_to_box;
   if (!pieces.empty()) j["pieces"] = pieces;
+  if (!auto_split.is_null()) j["auto_split"] = auto_split;
   for (const auto& [l, b] : orthant_boxes) {
     nlohmann::json bj = nlohmann::json::array();
     for (std::size_t i = 0; i < b.size(); ++i)

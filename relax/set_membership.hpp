@@ -180,6 +180,9 @@ struct BoundsSummary {
   bool clipped_to_box = false;
   // A run over a split box (relax/box_split.hpp): each piece's own summary as JSON, with its box.
   std::vector<nlohmann::json> pieces;
+  // A run with automatic cuts (relax/box_split.hpp): {"rounds": each round's box, cut and intervals, the first
+  // run first; "stopped": why no further round ran}. Null without automatic cuts.
+  nlohmann::json auto_split;
   nlohmann::json to_json() const;
   bool all_guaranteed() const;
   // Every orthant proven empty (by verified certificates when verification is on): no parameter in the box

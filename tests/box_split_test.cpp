@@ -126,6 +126,112 @@ TEST(LargestUnwitnessedPart, TheWidestSideNoCertifiedPointReaches) {
   EXPECT_DOUBLE_EQ(LargestUnwitnessedPart(s)->fraction, 0.5);
 }
 
+TEST(ProvenBox, OnlyVerifiedEndpointsShrinkTheBox) {
+  BoundsSummary s = Piece(-0.5, 0.25, "solved");
+  EXPECT_EQ(ProvenBox(s, kBox), (ParameterBox{{-0.5, 0.25}, {0, 4}, {-2, 2}}));  // q, r: not computed, kept
+  s.intervals[0].upper.verification = "unverified";  // a floating-point bound proves nothing
+  EXPECT_EQ(ProvenBox(s, kBox), (ParameterBox{{-0.5, 1}, {0, 4}, {-2, 2}}));
+  s.intervals[0].lower.verification = "off";
+  EXPECT_EQ(ProvenBox(s, kBox), kBox);
+  const BoundsSummary point = Piece(0.5, 0.5, "solved");  // no box side of width 0
+  EXPECT_EQ(ProvenBox(point, kBox), kBox);
+  EXPECT_EQ(ProvenBox(Piece(0, 0, "empty (LP)"), kBox), kBox);
+}
+
+TEST(AutoSplit, TheCutLiesBeyondTheWitnessAndEarlierCutsOutsideTheBoxGo) {
+  BoundsSummary s = Piece(-1.0, 3.0, "solved");
+  s.intervals[0].witnessed_lower = 0.0;
+  s.intervals[0].witnessed_upper = 1.0;
+  const auto part = LargestUnwitnessedPart(s);  // (1, 3]
+  ASSERT_TRUE(part);
+  EXPECT_DOUBLE_EQ(CutBeyondWitness(*part, s, 0.02), 1.08);  // 2 % of the width 4 above the witness
+  const UnwitnessedPart lower{"p", true, -1.0, 0.0, 0.25};
+  EXPECT_DOUBLE_EQ(CutBeyondWitness(lower, s, 0.05), -0.2);
+
+  const ParameterBox shrunk = {{-0.5, 0.9}, {0, 4}, {-2, 2}};
+  const auto cuts = WithCut({{"p", {-0.8, 0.5}}, {"q", {1}}}, "p", 0.2, shrunk, kNames);
+  ASSERT_EQ(cuts.size(), 2u);
+  EXPECT_EQ(cuts[0].parameter, "p");
+  EXPECT_EQ(cuts[0].values, (std::vector<double>{0.5, 0.2}));  // -0.8 lies outside the shrunk side
+  EXPECT_EQ(cuts[1].values, (std::vector<double>{1}));
+  EXPECT_TRUE(WithCut({{"p", {-0.8}}}, "p", 0.95, shrunk, kNames).empty()) << "no cut point left inside";
+  const auto again = WithCut(cuts, "p", 0.2, shrunk, kNames);
+  EXPECT_EQ(again[0].values, cuts[0].values);
+  EXPECT_EQ(WithCut({}, "r", 0.0, kBox, kNames).at(0).values, std::vector<double>{0.0});
+}
+
+TEST(AutoSplit, RoundsAndOptionsAreChecked) {
+  std::string error;
+  EXPECT_TRUE(ValidAutoSplitRounds(5, "fork", &error)) << error;
+  EXPECT_TRUE(ValidAutoSplitRounds(0, "mpi", &error)) << error;
+  EXPECT_FALSE(ValidAutoSplitRounds(6, "fork", &error));
+  EXPECT_EQ(error, "auto split: 6 rounds; expected 0 (off) to 5");
+  EXPECT_FALSE(ValidAutoSplitRounds(-1, "fork", &error));
+  EXPECT_FALSE(ValidAutoSplitRounds(1, "mpi", &error));
+  EXPECT_NE(error.find("not under the mpi executor"), std::string::npos) << error;
+  AutoSplitOptions o;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  o.margin = o.min_fraction;  // the cut-off part would hold the witness's side of the cut
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("margin"), std::string::npos) << error;
+  o = AutoSplitOptions{};
+  o.min_fraction = 0;
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
+// End to end (N = 60, n = 1, order 1: seconds): each automatic round is the split run of its cut in the box the
+// round before proved, its intervals lie inside the round before's and contain the truth.
+TEST(ComputeBoundsWithAutoSplit, EachRoundIsTheSplitRunOfItsCutInTheProvenBox) {
+  const HwOuterSet set = SeededSet(3, 60, 1, 60.0);
+  BoundsOptions options;
+  options.order = 1;
+  options.parameters = {"a1", "a2"};
+  options.edge_witness.min_order = 1;  // certified feasible points at order 1 too: the rounds cut beyond them
+  options.executor = std::make_shared<sdp::ForkExecutor>(2);
+  AutoSplitOptions auto_split;
+  auto_split.rounds = 2;
+  const auto result = ComputeBoundsWithAutoSplit(options, set, {}, auto_split);
+  const auto& rounds = result.auto_split.at("rounds");
+  ASSERT_GE(rounds.size(), 2u) << "the first run leaves a part of >= 10 % unwitnessed";
+  EXPECT_FALSE(result.auto_split.at("stopped").get<std::string>().empty());
+  EXPECT_EQ(result.box, set.box());
+  const auto first = ComputeBounds(options, set);
+  const auto part = LargestUnwitnessedPart(first);
+  ASSERT_TRUE(part);
+  const double cut = CutBeyondWitness(*part, first, auto_split.margin);
+  const auto& round1 = rounds[1];
+  EXPECT_EQ(round1.at("cut").at("parameter").get<std::string>(), part->parameter);
+  EXPECT_DOUBLE_EQ(round1.at("cut").at("value").get<double>(), cut);
+  const auto manual =
+      ComputeBoundsInPieces(options, set.WithBox(ProvenBox(first, set.box())), {{part->parameter, {cut}}});
+  const auto& r1 = round1.at("intervals");
+  ASSERT_EQ(r1.size(), manual.intervals.size());
+  for (std::size_t i = 0; i < manual.intervals.size(); ++i) {
+    EXPECT_EQ(r1[i].at("lower").get<double>(), manual.intervals[i].lower.value) << manual.intervals[i].name;
+    EXPECT_EQ(r1[i].at("upper").get<double>(), manual.intervals[i].upper.value) << manual.intervals[i].name;
+  }
+  double narrowed = 0;
+  for (std::size_t r = 1; r < rounds.size(); ++r) {
+    const auto& before = rounds[r - 1].at("intervals");
+    const auto& after = rounds[r].at("intervals");
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      EXPECT_GE(after[i].at("lower").get<double>(), before[i].at("lower").get<double>()) << r << " " << i;
+      EXPECT_LE(after[i].at("upper").get<double>(), before[i].at("upper").get<double>()) << r << " " << i;
+      narrowed += (before[i].at("upper").get<double>() - before[i].at("lower").get<double>()) -
+                  (after[i].at("upper").get<double>() - after[i].at("lower").get<double>());
+    }
+  }
+  EXPECT_GT(narrowed, 0.0);
+  // Guaranteed, verified, the truth inside, and inside the first run's intervals.
+  CompareEndpoints(result, first, [](const std::string& name, std::size_t, const Endpoint& x, const Endpoint& y,
+                                     bool lower) {
+    if (lower) EXPECT_GE(x.value, y.value) << name;
+    else EXPECT_LE(x.value, y.value) << name;
+  });
+  EXPECT_GT(result.sdp_jobs, first.sdp_jobs);  // counts summed over the rounds
+  EXPECT_GE(result.feasible_points.size(), first.feasible_points.size());
+}
+
 // End to end on the paper's example (N = 60, n = 1, order 1: seconds): a cut at the truth of a1 and one at
 // a1 = -0.5, below every point of D^ss(1) here, whose piece the engine proves empty.
 TEST(ComputeBoundsInPieces, TheHullContainsTheTruthAndAnEmptyPieceDropsOut) {

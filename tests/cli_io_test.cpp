@@ -84,6 +84,36 @@ TEST_F(CliIo, BadSplitIsNamedBeforeAnyWork) {
   }
 }
 
+TEST_F(CliIo, BadAutoSplitIsNamedBeforeAnyWork) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"--auto-split 6", "auto split: 6 rounds; expected 0 (off) to 5"},
+      {"--auto-split -1", "expected 0 (off) to 5"},
+      {"--auto-split 1 --executor mpi", "not under the mpi executor"},
+  };
+  for (const auto& [args, message] : bad) {
+    const auto r = Cli(Bounds(args));
+    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+    EXPECT_TRUE(Has(r.output, "--auto-split")) << args << ": " << r.output;
+    EXPECT_TRUE(Has(r.output, message)) << args << ": " << r.output;
+    EXPECT_FALSE(Has(r.output, "orthants:")) << "it ran: " << r.output;
+  }
+}
+
+// At order 1 the engine searches no feasible points, so there is nothing to cut beyond: no round runs, and the
+// output and the JSON say why (the rounds themselves: box_split_test).
+TEST_F(CliIo, AutoSplitSaysWhyNoRoundRan) {
+  const auto r = Cli(Bounds("--order 1 --threads 1 --params a1 --auto-split 2 --json " + Path("auto.json")));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Has(r.output, "automatic cuts: 0 round(s) after the first run (no interval has a range of certified "
+                            "feasible points to cut beyond)")) << r.output;
+  EXPECT_TRUE(Has(r.output, "round 0 (first run, 1 piece(s)): a1 [")) << r.output;
+  nlohmann::json j;
+  std::ifstream(Path("auto.json")) >> j;
+  ASSERT_EQ(j.at("auto_split").at("rounds").size(), 1u);
+  EXPECT_TRUE(j.at("auto_split").at("rounds")[0].at("cut").is_null());
+  EXPECT_EQ(j.at("auto_split").at("rounds")[0].at("intervals")[0].at("lower"), j.at("intervals")[0].at("lower").at("value"));
+}
+
 TEST_F(CliIo, SplitRunListsItsPiecesAndWritesThemToTheJson) {
   const auto r = Cli(Bounds("--order 1 --threads 1 --params a1,a2 --split a1=-0.5 --json " + Path("split.json")));
   ASSERT_EQ(r.code, 0) << r.output;

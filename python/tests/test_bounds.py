@@ -177,6 +177,22 @@ def test_split_box_as_in_the_cli(recording, tmp_path):
     assert [p["prior_box"][4]["hi"] for p in py["pieces"]] == [-0.5, 1.8, 10.0]
 
 
+def test_auto_split_as_in_the_cli(recording, tmp_path):
+    # Order 1 searches no feasible points: no round runs, and both say why (the rounds: box_split_test).
+    path, rec = recording
+    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1, "--params", "a1",
+            "--solver", "csdp", "--threads", 2, "--auto-split", 1, "--quiet", "--json", tmp_path / "cli.json")
+    cli = load_json(tmp_path / "cli.json")
+    py = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, parameters=["a1"],
+                         solver="csdp", threads=2, auto_split=1, source=path)
+    assert py["intervals"] == cli["intervals"]
+    assert [r["intervals"] for r in py["auto_split"]["rounds"]] == [r["intervals"] for r in cli["auto_split"]["rounds"]]
+    assert py["auto_split"]["stopped"] == cli["auto_split"]["stopped"] == \
+        "no interval has a range of certified feasible points to cut beyond"
+    assert "auto_split" not in hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1,
+                                               parameters=["a1"], solver="csdp", threads=2, source=path)
+
+
 def test_row_block_order_and_endpoint_refinements_as_in_the_cli(recording, tmp_path):
     path, rec = recording
     run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 2, "--params", "a1",

@@ -67,6 +67,9 @@ BOUNDS_CASES = [
     ({"split": {"a1": 10}}, ["--split", "a1=10"], "--split"),
     ({"split": {"zz": 0}}, ["--split", "zz=0"], "--split"),
     ({"split": {"a1": [1, 1]}}, ["--split", "a1=1,1"], "--split"),
+    # Automatic cuts: relax::ValidAutoSplitRounds.
+    ({"auto_split": 6}, ["--auto-split", 6], "--auto-split"),
+    ({"auto_split": -1}, ["--auto-split", -1], "--auto-split"),
 ]
 
 
