@@ -340,6 +340,46 @@ BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterS
   return combined;
 }
 
+namespace {
+
+// The round after `result` (run in `box` at `cuts`): its cut, box and cuts, or why there is none.
+struct NextRound {
+  std::optional<UnwitnessedPart> part;
+  double cut = 0.0;
+  ParameterBox box;
+  std::vector<BoxCut> cuts;
+  std::string stop;  // non-empty: no further round
+};
+
+NextRound PlanNextRound(const BoundsSummary& result, const ParameterBox& box, const std::vector<BoxCut>& cuts,
+                        const AutoSplitOptions& auto_split, const std::vector<std::string>& names) {
+  NextRound next;
+  if (result.invalidated()) {
+    next.stop = "every orthant is proven empty";
+    return next;
+  }
+  next.part = LargestUnwitnessedPart(result);
+  if (!next.part) {
+    next.stop = "no interval has a range of certified feasible points to cut beyond";
+    return next;
+  }
+  if (next.part->fraction < auto_split.min_fraction) {
+    next.stop = fmt::format("the largest unwitnessed part ({}, {:.1f}% of its interval) is under {:.0f}%",
+                            next.part->parameter, 100 * next.part->fraction, 100 * auto_split.min_fraction);
+    return next;
+  }
+  next.cut = CutBeyondWitness(*next.part, result, auto_split.margin);
+  next.box = ProvenBox(result, box);
+  next.cuts = WithCut(cuts, next.part->parameter, next.cut, next.box, names);
+  const auto same = [](const BoxCut& a, const BoxCut& b) { return a.parameter == b.parameter && a.values == b.values; };
+  if (next.box == box && std::equal(next.cuts.begin(), next.cuts.end(), cuts.begin(), cuts.end(), same))
+    next.stop = fmt::format("the next cut ({} = {:.6g}) is in place and the box did not shrink",
+                            next.part->parameter, next.cut);
+  return next;
+}
+
+}  // namespace
+
 BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwOuterSet& set,
                                          const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
                                          const std::function<void(const BoundsProgress&)>& progress) {
@@ -348,7 +388,6 @@ BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwO
   if (!ValidAutoSplitRounds(auto_split.rounds, options.executor ? options.executor->name() : "", &error))
     throw InputError(error);
   if (auto_split.rounds == 0) return ComputeBoundsInPieces(options, set, cuts, progress);
-  const std::vector<std::string>& names = set.layout().names;
   auto round_progress = [&](int round) {
     return [&progress, round](const BoundsProgress& p) {
       if (!progress) return;
@@ -364,36 +403,18 @@ BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwO
   std::string stopped = fmt::format("the {} round(s) asked for ran", auto_split.rounds);
   std::vector<BoundsSummary> earlier;
   for (int round = 1; round <= auto_split.rounds; ++round) {
-    if (result.invalidated()) {
-      stopped = "every orthant is proven empty";
+    NextRound plan = PlanNextRound(result, box, round_cuts, auto_split, set.layout().names);
+    if (!plan.stop.empty()) {
+      stopped = plan.stop;
       break;
     }
-    const auto part = LargestUnwitnessedPart(result);
-    if (!part) {
-      stopped = "no interval has a range of certified feasible points to cut beyond";
-      break;
-    }
-    if (part->fraction < auto_split.min_fraction) {
-      stopped = fmt::format("the largest unwitnessed part ({}, {:.1f}% of its interval) is under {:.0f}%",
-                            part->parameter, 100 * part->fraction, 100 * auto_split.min_fraction);
-      break;
-    }
-    const double cut = CutBeyondWitness(*part, result, auto_split.margin);
-    const ParameterBox proven = ProvenBox(result, box);
-    std::vector<BoxCut> next_cuts = WithCut(round_cuts, part->parameter, cut, proven, names);
-    if (proven == box && next_cuts.size() == round_cuts.size() &&
-        std::equal(next_cuts.begin(), next_cuts.end(), round_cuts.begin(),
-                   [](const BoxCut& a, const BoxCut& b) { return a.parameter == b.parameter && a.values == b.values; })) {
-      stopped = fmt::format("the next cut ({} = {:.6g}) is in place and the box did not shrink", part->parameter, cut);
-      break;
-    }
-    BoundsSummary next = ComputeBoundsInPieces(options, set.WithBox(proven), next_cuts, round_progress(round));
+    BoundsSummary next = ComputeBoundsInPieces(options, set.WithBox(plan.box), plan.cuts, round_progress(round));
     KeepWitnesses(result, next);
-    rounds.push_back(RoundJson(round, proven, part, cut, next));
+    rounds.push_back(RoundJson(round, plan.box, plan.part, plan.cut, next));
     earlier.push_back(std::move(result));
     result = std::move(next);
-    box = proven;
-    round_cuts = std::move(next_cuts);
+    box = std::move(plan.box);
+    round_cuts = std::move(plan.cuts);
   }
   for (const auto& e : earlier) AddCounts(e, result);
   result.box = set.box();
