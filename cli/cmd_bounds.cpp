@@ -296,8 +296,8 @@ void PrintUnwitnessedPart(const relax::BoundsSummary& summary) {
   const auto part = relax::LargestUnwitnessedPart(summary);
   if (!part || part->fraction < 0.1) return;
   fmt::print("\nlargest unwitnessed part: no certified feasible point has {} in {} ({:.0f}% of its interval); the "
-             "relaxation may overestimate there. A cut just {} {:.6g} (--split {}=VALUE) bounds that part on its own "
-             "and may prove it empty (README, \"Box split\").\n",
+             "relaxation may overestimate there. A cut just {} {:.6g} (--split {}=VALUE, or --auto-split 1 to place it) "
+             "bounds that part on its own and may prove it empty (README, \"Box split\").\n",
              part->parameter,
              part->below ? fmt::format("[{:.6g}, {:.6g})", part->bound, part->witnessed)
                          : fmt::format("({:.6g}, {:.6g}]", part->witnessed, part->bound),
