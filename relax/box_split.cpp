@@ -108,6 +108,12 @@ OrthantReport CombinedOrthant(const std::vector<BoundsSummary>& pieces, std::siz
   return r;
 }
 
+// `into`'s witnessed range widened to cover `from`'s (both ranges of certified points of one parameter).
+void WidenWitnessedRange(ParameterInterval& into, const ParameterInterval& from) {
+  if (from.witnessed_lower) into.witnessed_lower = std::min(into.witnessed_lower.value_or(*from.witnessed_lower), *from.witnessed_lower);
+  if (from.witnessed_upper) into.witnessed_upper = std::max(into.witnessed_upper.value_or(*from.witnessed_upper), *from.witnessed_upper);
+}
+
 // A round of ComputeBoundsWithAutoSplit as JSON: its box, the cut it added (none for the first run) and what it
 // gave.
 nlohmann::json RoundJson(int round, const ParameterBox& box, const std::optional<UnwitnessedPart>& part, double cut,
@@ -136,11 +142,8 @@ void KeepWitnesses(const BoundsSummary& earlier, BoundsSummary& later) {
                                earlier.feasible_points.end());
   if (earlier.invalidated() || later.invalidated()) return;
   for (auto& iv : later.intervals)
-    for (const auto& e : earlier.intervals) {
-      if (e.name != iv.name) continue;
-      if (e.witnessed_lower) iv.witnessed_lower = std::min(iv.witnessed_lower.value_or(*e.witnessed_lower), *e.witnessed_lower);
-      if (e.witnessed_upper) iv.witnessed_upper = std::max(iv.witnessed_upper.value_or(*e.witnessed_upper), *e.witnessed_upper);
-    }
+    for (const auto& e : earlier.intervals)
+      if (e.name == iv.name) WidenWitnessedRange(iv, e);
 }
 
 }  // namespace
@@ -232,8 +235,7 @@ BoundsSummary CombinePieces(const std::vector<BoundsSummary>& pieces, const Para
       const ParameterInterval& piv = pieces[p].intervals[i];
       lowers.push_back(&piv.lower);
       uppers.push_back(&piv.upper);
-      if (piv.witnessed_lower) iv.witnessed_lower = std::min(iv.witnessed_lower.value_or(*piv.witnessed_lower), *piv.witnessed_lower);
-      if (piv.witnessed_upper) iv.witnessed_upper = std::max(iv.witnessed_upper.value_or(*piv.witnessed_upper), *piv.witnessed_upper);
+      WidenWitnessedRange(iv, piv);
     }
     iv.lower = OutermostEndpoint(lowers, live, -1);
     iv.upper = OutermostEndpoint(uppers, live, +1);

@@ -45,6 +45,17 @@ class CliIo : public ::testing::Test {
   std::string Bounds(const std::string& extra) const {
     return "bounds --data " + Path("rec.csv") + " --noise-col noise_bound --horizon 1 --quiet " + extra;
   }
+  // Each (arguments, message) pair exits 2 naming `option` and the message, before any work.
+  void ExpectRefusedBeforeAnyWork(const std::vector<std::pair<std::string, std::string>>& bad,
+                                  const std::string& option) const {
+    for (const auto& [args, message] : bad) {
+      const auto r = Cli(Bounds(args));
+      EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+      EXPECT_TRUE(Has(r.output, option)) << args << ": " << r.output;
+      EXPECT_TRUE(Has(r.output, message)) << args << ": " << r.output;
+      EXPECT_FALSE(Has(r.output, "orthants:")) << "it ran: " << r.output;
+    }
+  }
   fs::path dir_;
 };
 
@@ -75,13 +86,7 @@ TEST_F(CliIo, BadSplitIsNamedBeforeAnyWork) {
       {"--box a1=0,3 --split a1=-1", "not strictly inside its prior box side [0, 3]"},
       {"--split a1=0 --split a1=1", "'a1' is cut twice"},
   };
-  for (const auto& [args, message] : bad) {
-    const auto r = Cli(Bounds(args));
-    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
-    EXPECT_TRUE(Has(r.output, "--split")) << args << ": " << r.output;
-    EXPECT_TRUE(Has(r.output, message)) << args << ": " << r.output;
-    EXPECT_FALSE(Has(r.output, "orthants:")) << "it ran: " << r.output;
-  }
+  ExpectRefusedBeforeAnyWork(bad, "--split");
 }
 
 TEST_F(CliIo, BadAutoSplitIsNamedBeforeAnyWork) {
@@ -90,13 +95,7 @@ TEST_F(CliIo, BadAutoSplitIsNamedBeforeAnyWork) {
       {"--auto-split -1", "expected 0 (off) to 5"},
       {"--auto-split 1 --executor mpi", "not under the mpi executor"},
   };
-  for (const auto& [args, message] : bad) {
-    const auto r = Cli(Bounds(args));
-    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
-    EXPECT_TRUE(Has(r.output, "--auto-split")) << args << ": " << r.output;
-    EXPECT_TRUE(Has(r.output, message)) << args << ": " << r.output;
-    EXPECT_FALSE(Has(r.output, "orthants:")) << "it ran: " << r.output;
-  }
+  ExpectRefusedBeforeAnyWork(bad, "--auto-split");
 }
 
 // At order 1 the engine searches no feasible points, so there is nothing to cut beyond: no round runs, and the
