@@ -207,6 +207,28 @@ TEST(CeroneTables, EquivalentSnrBisectionFindsTheCrossing) {
   EXPECT_TRUE(outside.to_json().contains("criterion"));
 }
 
+TEST(CeroneTables, EquivalentSnrReportsEachTablesOwnCriterion) {
+  // n = 2 ratios cross 1 at 40 dB, n = 3 ratios at 50 dB: the joint median lies between, each table's own
+  // criterion is its own.
+  auto ratios_at = [](double snr) {
+    std::vector<WidthRatio> r;
+    for (const char* name : {"a1", "a2"}) {
+      r.push_back({2, name, std::exp((40 - snr) / 10), 1.0});
+      r.push_back({3, name, std::exp((50 - snr) / 10), 1.0});
+    }
+    return r;
+  };
+  EquivalentSnrOptions options;
+  options.iterations = 3;
+  const auto found = FindEquivalentSnr(options, ratios_at);
+  const SnrEvaluation& first = found.evaluations.front();
+  EXPECT_EQ(first.horizons(), (std::vector<int>{2, 3}));
+  EXPECT_NEAR(first.criterion_of(2), (40 - 31.0) / 10, 1e-12);
+  EXPECT_NEAR(first.criterion_of(3), (50 - 31.0) / 10, 1e-12);
+  EXPECT_NEAR(first.criterion, (45 - 31.0) / 10, 1e-12);
+  EXPECT_NEAR(found.to_json()["evaluations"][0]["criterion_by_horizon"]["3"].get<double>(), 1.9, 1e-12);
+}
+
 TEST(CeroneTables, InnerHullsNarrowWithLessNoise) {
   TablesOptions options = SmallOptions();
   options.horizons = {2};

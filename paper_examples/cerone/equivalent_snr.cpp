@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <set>
 #include <stdexcept>
 
 namespace hw::cerone {
@@ -25,6 +27,21 @@ double MedianLogRatio(const std::vector<WidthRatio>& ratios) {
   return logs.size() % 2 ? logs[m] : 0.5 * (logs[m - 1] + logs[m]);
 }
 
+double MedianLogRatio(const std::vector<WidthRatio>& ratios, int horizon) {
+  std::vector<WidthRatio> of_horizon;
+  std::copy_if(ratios.begin(), ratios.end(), std::back_inserter(of_horizon),
+               [&](const WidthRatio& r) { return r.horizon == horizon; });
+  return MedianLogRatio(of_horizon);
+}
+
+std::vector<int> SnrEvaluation::horizons() const {
+  std::set<int> seen;
+  for (const auto& r : ratios) seen.insert(r.horizon);
+  return {seen.begin(), seen.end()};
+}
+
+double SnrEvaluation::criterion_of(int horizon) const { return MedianLogRatio(ratios, horizon); }
+
 std::string EquivalentSnrCriterionText() {
   return "criterion: median over the (n, parameter) pairs of the paper's tables of log(inner half-width / paper "
          "half-width); the equivalent SNR is where it crosses 0 (bisection on the SNR in dB, one seed)";
@@ -36,7 +53,10 @@ nlohmann::json EquivalentSnrResult::to_json() const {
     for (const auto& r : e.ratios)
       ratios.push_back({{"n", r.horizon}, {"parameter", r.parameter}, {"inner_half_width", r.inner_half},
                         {"paper_half_width", r.paper_half}, {"ratio", r.ratio()}});
-    return nlohmann::json{{"snr_db", e.snr_db}, {"criterion", e.criterion}, {"ratios", ratios}};
+    nlohmann::json by_horizon = nlohmann::json::object();
+    for (int n : e.horizons()) by_horizon[std::to_string(n)] = e.criterion_of(n);
+    return nlohmann::json{
+        {"snr_db", e.snr_db}, {"criterion", e.criterion}, {"criterion_by_horizon", by_horizon}, {"ratios", ratios}};
   };
   nlohmann::json all = nlohmann::json::array();
   for (const auto& e : evaluations) all.push_back(evaluation_json(e));

@@ -26,6 +26,10 @@ struct SnrEvaluation {
   double snr_db = 0.0;
   double criterion = 0.0;  // median log ratio
   std::vector<WidthRatio> ratios;
+  // The horizons present in `ratios`, ascending, and the criterion over each one's ratios alone: where a table's
+  // own crossing lies when the bisection runs on several tables at once.
+  std::vector<int> horizons() const;
+  double criterion_of(int horizon) const;
 };
 
 struct EquivalentSnrOptions {
@@ -43,6 +47,9 @@ struct EquivalentSnrResult {
 
 // The criterion of a set of ratios (NaN when none is usable: a zero or non-finite width).
 double MedianLogRatio(const std::vector<WidthRatio>& ratios);
+
+// The criterion over the ratios of one horizon only.
+double MedianLogRatio(const std::vector<WidthRatio>& ratios, int horizon);
 
 // What the criterion means, as printed.
 std::string EquivalentSnrCriterionText();

@@ -103,8 +103,19 @@ std::string EquivalentMarkdown(const EquivalentSnrResult& e, uint64_t seed) {
   md += e.bracketed ? fmt::format("Closest: **{:.2f} dB** (criterion {:.3f}).\n\n", e.best.snr_db, e.best.criterion)
                     : fmt::format("Not bracketed by the range: the closest end is {:.2f} dB (criterion {:.3f}).\n\n",
                                   e.best.snr_db, e.best.criterion);
-  md += "| SNR [dB] | criterion |\n|---|---|\n";
-  for (const auto& s : e.evaluations) md += fmt::format("| {:.2f} | {:.3f} |\n", s.snr_db, s.criterion);
+  // With several tables, each one's own criterion shows where that table alone would cross 0.
+  std::vector<int> own = e.best.horizons();
+  if (own.size() < 2) own.clear();
+  md += "| SNR [dB] | criterion |";
+  for (int n : own) md += fmt::format(" n = {} only |", n);
+  md += "\n|---|---|";
+  for (std::size_t i = 0; i < own.size(); ++i) md += "---|";
+  md += "\n";
+  for (const auto& s : e.evaluations) {
+    md += fmt::format("| {:.2f} | {:.3f} |", s.snr_db, s.criterion);
+    for (int n : own) md += fmt::format(" {:.3f} |", s.criterion_of(n));
+    md += "\n";
+  }
   md += fmt::format("\nAt {:.2f} dB:\n\n| n | parameter | inner half | paper half | ratio |\n|---|---|---|---|---|\n",
                     e.best.snr_db);
   for (const auto& r : e.best.ratios)
