@@ -117,8 +117,9 @@ std::vector<WidthRatio> InnerWidthRatios(const TablesOptions& options, double sn
   std::vector<WidthRatio> ratios;
   for (int n : options.horizons) {
     const auto set = ExampleSet(ex, n, options.box);
+    log(fmt::format("equivalent SNR: {:g} dB, n = {}: inner hull ...", snr_db, n));
     const auto hull = ComputeInnerHull(set, CeroneExample::TrueParameters(), ParameterIndices(set, options.params),
-                                       options.inner);
+                                       options.inner, {}, log);
     for (const auto& iv : hull.intervals)
       if (const auto paper = PaperTableInterval(iv.name, n); paper && iv.found)
         ratios.push_back({n, iv.name, iv.half_width(), paper->half_width()});
