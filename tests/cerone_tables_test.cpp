@@ -227,6 +227,11 @@ TEST(CeroneTables, EquivalentSnrReportsEachTablesOwnCriterion) {
   EXPECT_NEAR(first.criterion_of(3), (50 - 31.0) / 10, 1e-12);
   EXPECT_NEAR(first.criterion, (45 - 31.0) / 10, 1e-12);
   EXPECT_NEAR(found.to_json()["evaluations"][0]["criterion_by_horizon"]["3"].get<double>(), 1.9, 1e-12);
+  TablesReport report;
+  report.equivalent = found;
+  const std::string md = TablesMarkdown(report);
+  EXPECT_NE(md.find("| SNR [dB] | criterion | n = 2 only | n = 3 only |\n|---|---|---|---|\n"), std::string::npos);
+  EXPECT_NE(md.find("| 31.00 | 1.400 | 0.900 | 1.900 |\n"), std::string::npos) << md;
 }
 
 TEST(CeroneTables, InnerHullsNarrowWithLessNoise) {
