@@ -27,20 +27,18 @@ double MedianLogRatio(const std::vector<WidthRatio>& ratios) {
   return logs.size() % 2 ? logs[m] : 0.5 * (logs[m - 1] + logs[m]);
 }
 
-double MedianLogRatio(const std::vector<WidthRatio>& ratios, int horizon) {
-  std::vector<WidthRatio> of_horizon;
-  std::copy_if(ratios.begin(), ratios.end(), std::back_inserter(of_horizon),
-               [&](const WidthRatio& r) { return r.horizon == horizon; });
-  return MedianLogRatio(of_horizon);
-}
-
 std::vector<int> SnrEvaluation::horizons() const {
   std::set<int> seen;
   for (const auto& r : ratios) seen.insert(r.horizon);
   return {seen.begin(), seen.end()};
 }
 
-double SnrEvaluation::criterion_of(int horizon) const { return MedianLogRatio(ratios, horizon); }
+double SnrEvaluation::criterion_of(int horizon) const {
+  std::vector<WidthRatio> of_horizon;
+  std::copy_if(ratios.begin(), ratios.end(), std::back_inserter(of_horizon),
+               [&](const WidthRatio& r) { return r.horizon == horizon; });
+  return MedianLogRatio(of_horizon);
+}
 
 std::string EquivalentSnrCriterionText() {
   return "criterion: median over the (n, parameter) pairs of the paper's tables of log(inner half-width / paper "

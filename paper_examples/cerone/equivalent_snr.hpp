@@ -48,9 +48,6 @@ struct EquivalentSnrResult {
 // The criterion of a set of ratios (NaN when none is usable: a zero or non-finite width).
 double MedianLogRatio(const std::vector<WidthRatio>& ratios);
 
-// The criterion over the ratios of one horizon only.
-double MedianLogRatio(const std::vector<WidthRatio>& ratios, int horizon);
-
 // What the criterion means, as printed.
 std::string EquivalentSnrCriterionText();
 
