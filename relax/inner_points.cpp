@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "sdp/sdp_solver.hpp"
+
 namespace hw::relax {
 namespace {
 
@@ -166,6 +168,7 @@ InnerWitness LocalExtreme(const HwOuterSet& set, int l, int k, int dir, const st
   std::vector<double> x0(n);
   for (int i = 0; i < n; ++i) x0[i] = (start[i] - set.scaling().center[i]) / set.scaling().radius[i];
   Ipopt::SmartPtr<ExtremeNlp> nlp = new ExtremeNlp(std::move(cons), n, k, dir, x0, options.margin);
+  sdp::UseSingleThreadedBlas();  // MUMPS under Ipopt would otherwise start (and spin) one BLAS thread per core
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");

@@ -147,15 +147,16 @@ double RelativeGap(double primal, double dual) {
   return std::abs(primal - dual) / std::max(1.0, 0.5 * (std::abs(primal) + std::abs(dual)));
 }
 
-namespace {
-
 // Solves run in parallel in our own job pool: BLAS (OpenBLAS; Debian's libblas.so.3 alternative forwards
-// to the same libopenblas.so.0, so CSDP's -lblas and SDPA's -lopenblas share one setting) gets one
-// thread, so concurrent solves never oversubscribe the cores. Process-wide, set once.
-void SingleThreadedBlas() {
+// to the same libopenblas.so.0, so CSDP's -lblas, SDPA's -lopenblas and Ipopt's MUMPS share one setting)
+// gets one thread, so concurrent solves never oversubscribe the cores and the arithmetic does not depend on
+// the core count. Process-wide, set once.
+void UseSingleThreadedBlas() {
   static std::once_flag once;
   std::call_once(once, [] { openblas_set_num_threads(1); });
 }
+
+namespace {
 
 // Sums duplicate entries and drops zeros, matrix by matrix.
 std::vector<Entry> Canonical(const std::vector<Entry>& entries) {
@@ -216,13 +217,8 @@ SdpSummary SolveAsBackend(const std::string& name, const SdpOptions& options, co
   return out;
 }
 
-// OpenBLAS (the BLAS of both libraries here) starts one thread per core by default; jobs already run one per
-// core in worker processes, so each solve uses one BLAS thread: no oversubscription, and the same arithmetic
-// whatever the number of workers (results must not depend on it).
-extern "C" void openblas_set_num_threads(int);
-
 SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem, const CanonicalSolve& solve) {
-  openblas_set_num_threads(1);
+  UseSingleThreadedBlas();
   std::string error;
   if (options.IsValid(&error) && problem.IsValid(&error) && !options.initial_y.empty() &&
       static_cast<int>(options.initial_y.size()) != problem.num_vars())
@@ -233,7 +229,6 @@ SdpSummary SolveCanonical(const SdpOptions& options, const LmiProblem& problem, 
     out.message = error;
     return out;
   }
-  SingleThreadedBlas();
   LmiProblem reduced;
   reduced.blocks = problem.blocks;
   reduced.objective_offset = problem.objective_offset;

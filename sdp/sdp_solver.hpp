@@ -127,4 +127,8 @@ std::vector<std::string> AvailableSolvers();
 // (the message of every caller: the engine, the CLI and the Python module).
 bool ValidSolverName(const std::string& name, std::string* error);
 
+// One BLAS thread for the whole process: jobs run in parallel in our own pool, never inside BLAS, so
+// results do not depend on the core count. Called by every SDP solve and every local (Ipopt) solve.
+void UseSingleThreadedBlas();
+
 }  // namespace hw::sdp

@@ -7,6 +7,8 @@
 #include "relax/inner_points.hpp"
 #include "relax/set_membership.hpp"
 
+extern "C" int openblas_get_num_threads();
+
 namespace hw::relax {
 namespace {
 
@@ -42,6 +44,20 @@ TEST(InnerPoints, WitnessesAreFeasibleAndInsideTheGuaranteedIntervals) {
     }
     EXPECT_GE(found, 12) << "local optimisation from a strictly feasible truth should succeed for most objectives";
   }
+}
+
+// Inner hulls run local solves one after another beside parallel SDP workers: MUMPS under Ipopt must not
+// start one OpenBLAS thread per core (they spin in sched_yield and take the workers' cores). ctest runs each
+// test in its own process, so no SDP solve has set the thread count before this one.
+TEST(InnerPoints, LocalSolvesUseOneBlasThread) {
+  if (openblas_get_num_threads() == 1) GTEST_SKIP() << "OpenBLAS already starts with one thread here (one core, or OPENBLAS_NUM_THREADS=1)";
+  const auto ex = SimulateCeroneExample(11, 60, 31.0);
+  HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+  const auto truth = CeroneExample::TrueParameters();
+  const auto w = LocalExtreme(set, set.orthant_of(truth), 0, +1, truth);
+  EXPECT_TRUE(w.found) << w.message;
+  EXPECT_EQ(openblas_get_num_threads(), 1);
 }
 
 TEST(InnerPoints, AnInfeasibleRegionGivesNoWitness) {
