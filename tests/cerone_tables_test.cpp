@@ -3,6 +3,7 @@
 // check can fail), the equivalent-SNR bisection finds a known crossing, and the command line rejects bad values.
 #include <cmath>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
@@ -247,6 +248,20 @@ TEST(CeroneTables, InnerHullsNarrowWithLessNoise) {
     EXPECT_LT(at60[i].ratio(), at31[i].ratio()) << at31[i].parameter;
   }
   EXPECT_LT(MedianLogRatio(at60), MedianLogRatio(at31));
+}
+
+// With two tables the evaluation's log line carries each table's own criterion: a bisection stopped before its
+// JSON is written still tells where each table stood.
+TEST(CeroneTables, EvaluationLogShowsEachTablesOwnCriterion) {
+  TablesOptions options = SmallOptions();
+  options.horizons = {2, 3};
+  options.samples = 60;
+  std::string last;
+  const auto ratios = InnerWidthRatios(options, 31, 1, [&](const std::string& line) { last = line; });
+  const SnrEvaluation evaluation{31, MedianLogRatio(ratios), ratios};
+  ASSERT_EQ(evaluation.horizons(), (std::vector<int>{2, 3}));
+  EXPECT_EQ(last, fmt::format("equivalent SNR: 31 dB -> median log ratio {:.3f} (n = 2: {:.3f}, n = 3: {:.3f})",
+                              evaluation.criterion, evaluation.criterion_of(2), evaluation.criterion_of(3)));
 }
 
 // The engine's feasible points enter the inner hull when they certify (the harness passes them as `given`):

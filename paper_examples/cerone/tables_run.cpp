@@ -124,7 +124,15 @@ std::vector<WidthRatio> InnerWidthRatios(const TablesOptions& options, double sn
       if (const auto paper = PaperTableInterval(iv.name, n); paper && iv.found)
         ratios.push_back({n, iv.name, iv.half_width(), paper->half_width()});
   }
-  log(fmt::format("equivalent SNR: {:g} dB -> median log ratio {:.3f}", snr_db, MedianLogRatio(ratios)));
+  // Each table's own criterion too: the run may be stopped before the JSON that holds them is written.
+  const SnrEvaluation evaluation{snr_db, MedianLogRatio(ratios), ratios};
+  std::string per_table;
+  if (evaluation.horizons().size() > 1) {
+    for (int n : evaluation.horizons())
+      per_table += fmt::format("{}n = {}: {:.3f}", per_table.empty() ? " (" : ", ", n, evaluation.criterion_of(n));
+    per_table += ")";
+  }
+  log(fmt::format("equivalent SNR: {:g} dB -> median log ratio {:.3f}{}", snr_db, evaluation.criterion, per_table));
   return ratios;
 }
 
