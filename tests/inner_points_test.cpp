@@ -50,7 +50,8 @@ TEST(InnerPoints, WitnessesAreFeasibleAndInsideTheGuaranteedIntervals) {
 // start one OpenBLAS thread per core (they spin in sched_yield and take the workers' cores). ctest runs each
 // test in its own process, so no SDP solve has set the thread count before this one.
 TEST(InnerPoints, LocalSolvesUseOneBlasThread) {
-  if (openblas_get_num_threads() == 1) GTEST_SKIP() << "OpenBLAS already starts with one thread here (one core, or OPENBLAS_NUM_THREADS=1)";
+  if (openblas_get_num_threads() == 1)
+    GTEST_SKIP() << "OpenBLAS already starts with one thread here (one core, or OPENBLAS_NUM_THREADS=1)";
   const auto ex = SimulateCeroneExample(11, 60, 31.0);
   HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
   HwOuterSet set(CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));

@@ -126,9 +126,10 @@ std::vector<WidthRatio> InnerWidthRatios(const TablesOptions& options, double sn
   }
   // Each table's own criterion too: the run may be stopped before the JSON that holds them is written.
   const SnrEvaluation evaluation{snr_db, MedianLogRatio(ratios), ratios};
+  const std::vector<int> horizons = evaluation.horizons();
   std::string per_table;
-  if (evaluation.horizons().size() > 1) {
-    for (int n : evaluation.horizons())
+  if (horizons.size() > 1) {
+    for (int n : horizons)
       per_table += fmt::format("{}n = {}: {:.3f}", per_table.empty() ? " (" : ", ", n, evaluation.criterion_of(n));
     per_table += ")";
   }
