@@ -1,9 +1,11 @@
 // The exact membership LP and the inner hull of D (exact/membership.hpp, exact/inner_hull.hpp).
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
@@ -96,6 +98,39 @@ TEST(RandomHw, CoversTheStructuresAndIsAFunctionOfTheSeed) {
   const auto a = testing::MakeRandomHwInstance(7), b = testing::MakeRandomHwInstance(7);
   EXPECT_EQ(a.data.y, b.data.y);
   EXPECT_EQ(a.theta, b.theta);
+}
+
+
+// Paper 001's example on the bundled recording (N = 300): the inner hull from the truth inside the prior box,
+// with a narrowed to a neighbourhood of the truth (where D lies, by the exact-set facts).
+TEST(ExactInnerHull, BundledRecordingFromTheTruth) {
+  const LiftedData data = BundledRecording();
+  auto solver = MakeLpSolver("clp");
+  const auto truth = CeroneExample::TrueParameters();
+  ParamBox box(8, Interval(-10.0, 10.0));
+  box[4] = Interval(1.79, 1.81);
+  box[5] = Interval(0.89, 0.91);
+  InnerHullOptions options;
+  options.restarts = 1;
+  const InnerHull hull = ComputeInnerHull(data, box, truth, options, *solver);
+  std::string summary;
+  for (int k = 0; k < 8; ++k) {
+    ASSERT_TRUE(hull.ranges[k].has_value()) << data.layout.names[k];
+    const auto [lo, hi] = *hull.ranges[k];
+    summary += fmt::format("{} [{:.6g}, {:.6g}] ", data.layout.names[k], lo, hi);
+    EXPECT_LE(lo, truth[k]) << data.layout.names[k];
+    EXPECT_GE(hi, truth[k]) << data.layout.names[k];
+    EXPECT_LT(lo, hi) << data.layout.names[k];  // the search moved every parameter
+  }
+  std::printf("inner hull: %s(%d local solves, %.1f s)\n", summary.c_str(), hull.local_solves, hull.seconds);
+  // Every returned point is in D by an independent membership check, and inside the box.
+  ASSERT_FALSE(hull.points.empty());
+  for (const auto& p : hull.points) {
+    const MembershipResult r = CheckMembership(data, p.theta, *solver);
+    EXPECT_TRUE(r.member) << p.objective << ": slack " << r.slack;
+    EXPECT_GE(p.slack, 0.0) << p.objective;
+    for (int k = 0; k < 8; ++k) EXPECT_TRUE(box[k].contains(p.theta[k])) << p.objective;
+  }
 }
 
 }  // namespace
