@@ -4,6 +4,8 @@
 #include <IpTNLP.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -95,8 +97,9 @@ class Sensitivities {
 
 class BandNlp : public Ipopt::TNLP {
  public:
-  BandNlp(const LiftedData& data, const ParamBox& box, const BandNlpRequest& request)
-      : d_(data), box_(box), req_(request), sens_(data), n_(data.layout.count()) {}
+  // The band rows of `samples` only (the working set); the monotonicity rows always.
+  BandNlp(const LiftedData& data, const ParamBox& box, const BandNlpRequest& request, const std::vector<int>& samples)
+      : d_(data), box_(box), req_(request), samples_(samples), sens_(data), n_(data.layout.count()) {}
   BandNlpResult result;
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
@@ -114,7 +117,7 @@ class BandNlp : public Ipopt::TNLP {
       xl[p] = p < n_ ? box_[p].lo : -kIpoptInf;
       xu[p] = p < n_ ? box_[p].hi : kIpoptInf;
     }
-    for (int r = 0; r < m; ++r) gl[r] = r < 2 * d_.num_samples ? req_.margin : 0.0, gu[r] = kIpoptInf;
+    for (int r = 0; r < m; ++r) gl[r] = r < 2 * num_bands() ? req_.margin : 0.0, gu[r] = kIpoptInf;
     return true;
   }
   bool get_starting_point(Ipopt::Index n, bool, Ipopt::Number* x, bool, Ipopt::Number*, Ipopt::Number*,
@@ -135,12 +138,13 @@ class BandNlp : public Ipopt::TNLP {
   bool eval_g(Ipopt::Index, const Ipopt::Number* x, bool new_x, Ipopt::Index, Ipopt::Number* g) override {
     if (new_x || !evaluated_) Update(x);
     const auto& alpha = sens_.model().alpha;
-    for (int t = 0; t < d_.num_samples; ++t) {
-      g[2 * t] = sens_.z(t) - OutputMapValue(d_.phi_lo[t], alpha);
-      g[2 * t + 1] = OutputMapValue(d_.phi_hi[t], alpha) - sens_.z(t);
+    for (int r = 0; r < num_bands(); ++r) {
+      const int t = samples_[r];
+      g[2 * r] = sens_.z(t) - OutputMapValue(d_.phi_lo[t], alpha);
+      g[2 * r + 1] = OutputMapValue(d_.phi_hi[t], alpha) - sens_.z(t);
     }
     for (std::size_t m = 0; m + 1 < d_.phi_grid.size(); ++m)
-      g[2 * d_.num_samples + m] = OutputMapValue(d_.phi_grid[m + 1], alpha) - OutputMapValue(d_.phi_grid[m], alpha);
+      g[2 * num_bands() + m] = OutputMapValue(d_.phi_grid[m + 1], alpha) - OutputMapValue(d_.phi_grid[m], alpha);
     return true;
   }
   bool eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipopt::Index m, Ipopt::Index,
@@ -153,8 +157,9 @@ class BandNlp : public Ipopt::TNLP {
     if (new_x || !evaluated_) Update(x);
     std::fill(values, values + static_cast<std::size_t>(n) * m, 0.0);
     const int alpha_begin = d_.layout.alpha_begin;
-    for (int t = 0; t < d_.num_samples; ++t) {
-      double* lower = values + static_cast<std::size_t>(2 * t) * n;
+    for (int r = 0; r < num_bands(); ++r) {
+      const int t = samples_[r];
+      double* lower = values + static_cast<std::size_t>(2 * r) * n;
       double* upper = lower + n;
       const double* dz = sens_.dz(t);
       for (int p = 0; p < n; ++p) lower[p] = dz[p], upper[p] = -dz[p];
@@ -164,7 +169,7 @@ class BandNlp : public Ipopt::TNLP {
       }
     }
     for (std::size_t g = 0; g + 1 < d_.phi_grid.size(); ++g) {
-      double* row = values + (static_cast<std::size_t>(2 * d_.num_samples) + g) * n;
+      double* row = values + (static_cast<std::size_t>(2 * num_bands()) + g) * n;
       for (int j = 0; j < d_.layout.num_alpha; ++j)
         row[alpha_begin + j] = d_.phi_grid[g + 1][j + 1].mid() - d_.phi_grid[g][j + 1].mid();
     }
@@ -181,8 +186,8 @@ class BandNlp : public Ipopt::TNLP {
     }
     if (new_x || !evaluated_) Update(x);
     // The objective and the alpha terms are linear: only z_t is curved, with weight lambda_lower - lambda_upper.
-    std::vector<double> weight(d_.num_samples);
-    for (int t = 0; t < d_.num_samples; ++t) weight[t] = lambda[2 * t] - lambda[2 * t + 1];
+    std::vector<double> weight(d_.num_samples, 0.0);
+    for (int r = 0; r < num_bands(); ++r) weight[samples_[r]] = lambda[2 * r] - lambda[2 * r + 1];
     const std::vector<double> h = sens_.WeightedHessian(weight);
     for (int p = 0; p < n; ++p)
       for (int q = 0; q <= p; ++q) values[e++] = h[static_cast<std::size_t>(p) * n + q];
@@ -195,10 +200,12 @@ class BandNlp : public Ipopt::TNLP {
     result.status = fmt::format("Ipopt status {}", static_cast<int>(status));
     result.theta.resize(n_);
     for (int p = 0; p < n_; ++p) result.theta[p] = std::clamp(x[p], box_[p].lo, box_[p].hi);
+    result.initial_state.assign(x + n_, x + sens_.num_vars());
   }
 
  private:
-  int num_rows() const { return 2 * d_.num_samples + std::max<int>(0, static_cast<int>(d_.phi_grid.size()) - 1); }
+  int num_bands() const { return static_cast<int>(samples_.size()); }
+  int num_rows() const { return 2 * num_bands() + std::max<int>(0, static_cast<int>(d_.phi_grid.size()) - 1); }
   void Update(const double* x) {
     sens_.Evaluate(x);
     evaluated_ = true;
@@ -206,15 +213,16 @@ class BandNlp : public Ipopt::TNLP {
   const LiftedData& d_;
   const ParamBox& box_;
   const BandNlpRequest& req_;
+  const std::vector<int>& samples_;
   Sensitivities sens_;
   int n_;
   bool evaluated_ = false;
 };
 
-}  // namespace
-
-BandNlpResult SolveBandNlp(const LiftedData& data, const ParamBox& box, const BandNlpRequest& request) {
-  Ipopt::SmartPtr<BandNlp> nlp = new BandNlp(data, box, request);
+// One Ipopt solve on the band rows of `samples`.
+BandNlpResult SolveOnSamples(const LiftedData& data, const ParamBox& box, const BandNlpRequest& request,
+                             const std::vector<int>& samples) {
+  Ipopt::SmartPtr<BandNlp> nlp = new BandNlp(data, box, request, samples);
   sdp::UseSingleThreadedBlas();  // MUMPS under Ipopt would otherwise start (and spin) one BLAS thread per core
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   auto opts = app->Options();
@@ -235,6 +243,63 @@ BandNlpResult SolveBandNlp(const LiftedData& data, const ParamBox& box, const Ba
   }
   app->OptimizeTNLP(nlp);
   return nlp->result;
+}
+
+// Band margins min(z_t - lo_t, hi_t - z_t) of every sample at (theta, initial state).
+std::vector<double> Margins(const LiftedData& data, const std::vector<double>& theta, const std::vector<double>& initial) {
+  const ModelParameters m = DecodeTheta(data, theta);
+  const BandEnds bands = ComputeBandEnds(data, m);
+  const std::vector<double> z = SimulateOutput(data, m, InputSignal(data, m), initial);
+  std::vector<double> margin(z.size());
+  for (std::size_t t = 0; t < z.size(); ++t)
+    margin[t] = std::isfinite(z[t]) ? std::min(z[t] - bands.lo[t], bands.hi[t] - z[t]) : -kIpoptInf;
+  return margin;
+}
+
+// The `count` samples outside `taken` with the smallest margins below `threshold`, smallest first.
+std::vector<int> TightestSamples(const std::vector<double>& margin, const std::vector<bool>& taken, double threshold,
+                                 std::size_t count) {
+  std::vector<int> tight;
+  for (std::size_t t = 0; t < margin.size(); ++t)
+    if (!taken[t] && margin[t] < threshold) tight.push_back(static_cast<int>(t));
+  const std::size_t keep = std::min(count, tight.size());
+  std::partial_sort(tight.begin(), tight.begin() + keep, tight.end(),
+                    [&](int a, int b) { return margin[a] < margin[b] || (margin[a] == margin[b] && a < b); });
+  tight.resize(keep);
+  return tight;
+}
+
+}  // namespace
+
+// Constraint generation: the NLP starts on the samples whose bands are tightest at the start, and the samples
+// a solution leaves (margin below half the requested one) join the working set until it leaves none. Most
+// bands are far from active, so each solve sees a few hundred rows whatever N is.
+BandNlpResult SolveBandNlp(const LiftedData& data, const ParamBox& box, const BandNlpRequest& request) {
+  const int N = data.num_samples;
+  const std::size_t batch = static_cast<std::size_t>(std::max(100, N / 50));
+  std::vector<bool> taken(N, false);
+  std::vector<int> samples;
+  auto take = [&](const std::vector<int>& more) {
+    for (int t : more) taken[t] = true;
+    samples.insert(samples.end(), more.begin(), more.end());
+    std::sort(samples.begin(), samples.end());
+  };
+  take(TightestSamples(Margins(data, request.theta, request.initial_state), taken, kIpoptInf, batch));
+  BandNlpRequest current = request;
+  const auto clock_start = std::chrono::steady_clock::now();
+  for (int round = 0;; ++round) {
+    BandNlpResult result = SolveOnSamples(data, box, current, samples);
+    result.rounds = round + 1;
+    result.working_samples = static_cast<int>(samples.size());
+    if (!result.returned || static_cast<int>(samples.size()) == N) return result;
+    const std::vector<int> left = TightestSamples(Margins(data, result.theta, result.initial_state), taken,
+                                                  0.5 * request.margin, 2 * batch);
+    current.cpu_seconds = request.cpu_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+    if (left.empty() || current.cpu_seconds <= 0) return result;
+    take(left);
+    current.theta = result.theta;
+    current.initial_state = result.initial_state;
+  }
 }
 
 }  // namespace hw::exact

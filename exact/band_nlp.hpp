@@ -18,13 +18,16 @@ struct BandNlpRequest {
   std::vector<double> theta;         // start
   std::vector<double> initial_state; // start, z_0 .. z_{T0-1}
   double margin = 0.0;               // kept from each band end, in units of z
-  double cpu_seconds = 60.0;         // Ipopt's limit for this solve
+  double cpu_seconds = 60.0;         // the limit for this request (Ipopt's CPU time, the working set's rounds)
 };
 
 struct BandNlpResult {
   bool returned = false;       // Ipopt returned a point (whatever its status)
   std::vector<double> theta;   // in the box
-  std::string status;          // Ipopt's return status, for messages
+  std::vector<double> initial_state;
+  std::string status;          // Ipopt's return status (of the last round), for messages
+  int rounds = 0;              // Ipopt solves: the working set grew rounds - 1 times
+  int working_samples = 0;     // samples whose bands were constraints in the last round
 };
 
 BandNlpResult SolveBandNlp(const LiftedData& data, const ParamBox& box, const BandNlpRequest& request);

@@ -111,7 +111,7 @@ TEST(ExactInnerHull, BundledRecordingFromTheTruth) {
   box[4] = Interval(1.79, 1.81);
   box[5] = Interval(0.89, 0.91);
   InnerHullOptions options;
-  options.restarts = 1;
+  options.restarts = 0;
   const InnerHull hull = ComputeInnerHull(data, box, truth, options, *solver);
   std::string summary;
   for (int k = 0; k < 8; ++k) {
@@ -131,6 +131,80 @@ TEST(ExactInnerHull, BundledRecordingFromTheTruth) {
     EXPECT_GE(p.slack, 0.0) << p.objective;
     for (int k = 0; k < 8; ++k) EXPECT_TRUE(box[k].contains(p.theta[k])) << p.objective;
   }
+}
+
+
+ParamBox BoxAround(const std::vector<double>& theta, double radius) {
+  ParamBox box;
+  for (double v : theta) box.emplace_back(v - radius, v + radius);
+  return box;
+}
+
+// Every point the hull returns is in D by an independent check and in the box; the ranges are theirs.
+void ExpectCertifiedHull(const LiftedData& data, const ParamBox& box, const InnerHull& hull, LpSolver& solver,
+                         const std::string& what) {
+  ASSERT_FALSE(hull.points.empty()) << what;
+  const int n = data.layout.count();
+  for (const auto& p : hull.points) {
+    EXPECT_TRUE(CheckMembership(data, p.theta, solver).member) << what << ", " << p.objective;
+    for (int k = 0; k < n; ++k) EXPECT_TRUE(box[k].contains(p.theta[k])) << what << ", " << p.objective;
+  }
+  for (int k = 0; k < n; ++k) {
+    ASSERT_TRUE(hull.ranges[k].has_value()) << what;
+    bool low = false, high = false;
+    for (const auto& p : hull.points) low |= p.theta[k] == hull.ranges[k]->first, high |= p.theta[k] == hull.ranges[k]->second;
+    EXPECT_TRUE(low && high) << what << ": the range of " << data.layout.names[k] << " is not attained by a point";
+  }
+}
+
+TEST(ExactInnerHull, RandomSystemsFromTheTruthWithRestarts) {
+  auto solver = MakeLpSolver("clp");
+  InnerHullOptions options;
+  options.restarts = 1;
+  for (uint64_t seed : {2, 5, 11}) {
+    testing::RandomHwOptions gen;
+    gen.max_samples = 150;
+    const auto inst = testing::MakeRandomHwInstance(seed, gen);
+    const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+    const ParamBox box = BoxAround(inst.theta, 1.0);
+    const InnerHull hull = ComputeInnerHull(data, box, inst.theta, options, *solver);
+    ExpectCertifiedHull(data, box, hull, *solver, inst.description);
+    for (int k = 0; k < data.layout.count(); ++k) {
+      EXPECT_LE(hull.ranges[k]->first, inst.theta[k]) << inst.description;
+      EXPECT_GE(hull.ranges[k]->second, inst.theta[k]) << inst.description;
+    }
+    EXPECT_EQ(hull.local_solves, 2 * 2 * data.layout.count()) << inst.description;
+  }
+}
+
+TEST(ExactInnerHull, FindsPointsOfDFromAStartOutsideIt) {
+  const auto inst = testing::MakeRandomHwInstance(5);
+  const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+  auto solver = MakeLpSolver("clp");
+  auto start = inst.theta;
+  start[data.layout.a_begin] += 0.05;
+  ASSERT_FALSE(CheckMembership(data, start, *solver).member) << inst.description;
+  const ParamBox box = BoxAround(inst.theta, 1.0);
+  const InnerHull hull = ComputeInnerHull(data, box, start, InnerHullOptions{}, *solver);
+  ExpectCertifiedHull(data, box, hull, *solver, inst.description);
+  for (const auto& p : hull.points) EXPECT_NE(p.objective, "start");
+}
+
+TEST(ExactInnerHull, RejectsBadOptionsAndShapes) {
+  const auto inst = testing::MakeRandomHwInstance(3);
+  const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+  auto solver = MakeLpSolver("clp");
+  InnerHullOptions options;
+  std::string error;
+  options.restarts = -1;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("restarts"), std::string::npos);
+  EXPECT_THROW(ComputeInnerHull(data, BoxAround(inst.theta, 1.0), inst.theta, options, *solver), std::invalid_argument);
+  options = {};
+  options.time_limit_seconds = 0;
+  EXPECT_FALSE(options.IsValid(&error));
+  options = {};
+  EXPECT_THROW(ComputeInnerHull(data, BoxAround(inst.theta, 1.0), {1.0}, options, *solver), std::invalid_argument);
 }
 
 }  // namespace
