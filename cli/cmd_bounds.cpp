@@ -73,7 +73,7 @@ std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
   return cuts;
 }
 
-// Exit status of a run whose data prove that no parameter in the prior box fits (README, `bounds --help`).
+// Exit status of a run whose data prove that no parameter in the prior box fits (docs/input_output.md, `bounds --help`).
 constexpr int kExitInvalidated = 3;
 
 struct BoundsCliOptions {
@@ -297,7 +297,7 @@ void PrintUnwitnessedPart(const relax::BoundsSummary& summary) {
   if (!part || part->fraction < 0.1) return;
   fmt::print("\nlargest unwitnessed part: no certified feasible point has {} in {} ({:.0f}% of its interval); the "
              "relaxation may overestimate there. A cut just {} {:.6g} (--split {}=VALUE, or --auto-split 1 to place it) "
-             "bounds that part on its own and may prove it empty (README, \"Box split\").\n",
+             "bounds that part on its own and may prove it empty (docs/setmembership.md, \"Box split\").\n",
              part->parameter,
              part->below ? fmt::format("[{:.6g}, {:.6g})", part->bound, part->witnessed)
                          : fmt::format("({:.6g}, {:.6g}]", part->witnessed, part->bound),
@@ -428,11 +428,11 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--split", o->split,
                   "cut the prior box at these values of one parameter, NAME=VALUE[,VALUE...] (repeat for more "
                   "parameters): each piece is bounded on its own and the intervals are the hull over the pieces, "
-                  "often tighter (README, \"The relaxation gap\")");
+                  "often tighter (docs/cerone_tables.md, \"The relaxation gap at δ = 3\")");
   cmd->add_option("--auto-split", o->auto_split,
                   "after the run, up to this many rounds (0..5): shrink the box to the verified intervals, cut off "
                   "the largest part of an interval no certified feasible point reaches (from 10% of its width) just "
-                  "beyond that point, and bound again over the pieces (README, \"Box split\")");
+                  "beyond that point, and bound again over the pieces (docs/setmembership.md, \"Box split\")");
   cmd->add_option("--solver", o->solver,
                   fmt::format("SDP backend: auto (CSDP, measured fastest at orders 2 and 3; docs/sdp.md), {}",
                               fmt::join(sdp::AvailableSolvers(), ", ")));
