@@ -1,9 +1,11 @@
 // The exact membership LP and the inner hull of D (exact/membership.hpp, exact/inner_hull.hpp).
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
@@ -96,6 +98,113 @@ TEST(RandomHw, CoversTheStructuresAndIsAFunctionOfTheSeed) {
   const auto a = testing::MakeRandomHwInstance(7), b = testing::MakeRandomHwInstance(7);
   EXPECT_EQ(a.data.y, b.data.y);
   EXPECT_EQ(a.theta, b.theta);
+}
+
+
+// Paper 001's example on the bundled recording (N = 300): the inner hull from the truth inside the prior box,
+// with a narrowed to a neighbourhood of the truth (where D lies, by the exact-set facts).
+TEST(ExactInnerHull, BundledRecordingFromTheTruth) {
+  const LiftedData data = BundledRecording();
+  auto solver = MakeLpSolver("clp");
+  const auto truth = CeroneExample::TrueParameters();
+  ParamBox box(8, Interval(-10.0, 10.0));
+  box[4] = Interval(1.79, 1.81);
+  box[5] = Interval(0.89, 0.91);
+  InnerHullOptions options;
+  options.restarts = 0;
+  const InnerHull hull = ComputeInnerHull(data, box, truth, options, *solver);
+  std::string summary;
+  for (int k = 0; k < 8; ++k) {
+    ASSERT_TRUE(hull.ranges[k].has_value()) << data.layout.names[k];
+    const auto [lo, hi] = *hull.ranges[k];
+    summary += fmt::format("{} [{:.6g}, {:.6g}] ", data.layout.names[k], lo, hi);
+    EXPECT_LE(lo, truth[k]) << data.layout.names[k];
+    EXPECT_GE(hi, truth[k]) << data.layout.names[k];
+    EXPECT_LT(lo, hi) << data.layout.names[k];  // the search moved every parameter
+  }
+  std::printf("inner hull: %s(%d local solves, %.1f s)\n", summary.c_str(), hull.local_solves, hull.seconds);
+  // Every returned point is in D by an independent membership check, and inside the box.
+  ASSERT_FALSE(hull.points.empty());
+  for (const auto& p : hull.points) {
+    const MembershipResult r = CheckMembership(data, p.theta, *solver);
+    EXPECT_TRUE(r.member) << p.objective << ": slack " << r.slack;
+    EXPECT_GE(p.slack, 0.0) << p.objective;
+    for (int k = 0; k < 8; ++k) EXPECT_TRUE(box[k].contains(p.theta[k])) << p.objective;
+  }
+}
+
+
+ParamBox BoxAround(const std::vector<double>& theta, double radius) {
+  ParamBox box;
+  for (double v : theta) box.emplace_back(v - radius, v + radius);
+  return box;
+}
+
+// Every point the hull returns is in D by an independent check and in the box; the ranges are theirs.
+void ExpectCertifiedHull(const LiftedData& data, const ParamBox& box, const InnerHull& hull, LpSolver& solver,
+                         const std::string& what) {
+  ASSERT_FALSE(hull.points.empty()) << what;
+  const int n = data.layout.count();
+  for (const auto& p : hull.points) {
+    EXPECT_TRUE(CheckMembership(data, p.theta, solver).member) << what << ", " << p.objective;
+    for (int k = 0; k < n; ++k) EXPECT_TRUE(box[k].contains(p.theta[k])) << what << ", " << p.objective;
+  }
+  for (int k = 0; k < n; ++k) {
+    ASSERT_TRUE(hull.ranges[k].has_value()) << what;
+    bool low = false, high = false;
+    for (const auto& p : hull.points) low |= p.theta[k] == hull.ranges[k]->first, high |= p.theta[k] == hull.ranges[k]->second;
+    EXPECT_TRUE(low && high) << what << ": the range of " << data.layout.names[k] << " is not attained by a point";
+  }
+}
+
+TEST(ExactInnerHull, RandomSystemsFromTheTruthWithRestarts) {
+  auto solver = MakeLpSolver("clp");
+  InnerHullOptions options;
+  options.restarts = 1;
+  for (uint64_t seed : {2, 5, 11}) {
+    testing::RandomHwOptions gen;
+    gen.max_samples = 150;
+    const auto inst = testing::MakeRandomHwInstance(seed, gen);
+    const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+    const ParamBox box = BoxAround(inst.theta, 1.0);
+    const InnerHull hull = ComputeInnerHull(data, box, inst.theta, options, *solver);
+    ExpectCertifiedHull(data, box, hull, *solver, inst.description);
+    for (int k = 0; k < data.layout.count(); ++k) {
+      EXPECT_LE(hull.ranges[k]->first, inst.theta[k]) << inst.description;
+      EXPECT_GE(hull.ranges[k]->second, inst.theta[k]) << inst.description;
+    }
+    EXPECT_EQ(hull.local_solves, 2 * 2 * data.layout.count()) << inst.description;
+  }
+}
+
+TEST(ExactInnerHull, FindsPointsOfDFromAStartOutsideIt) {
+  const auto inst = testing::MakeRandomHwInstance(5);
+  const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+  auto solver = MakeLpSolver("clp");
+  auto start = inst.theta;
+  start[data.layout.a_begin] += 0.05;
+  ASSERT_FALSE(CheckMembership(data, start, *solver).member) << inst.description;
+  const ParamBox box = BoxAround(inst.theta, 1.0);
+  const InnerHull hull = ComputeInnerHull(data, box, start, InnerHullOptions{}, *solver);
+  ExpectCertifiedHull(data, box, hull, *solver, inst.description);
+  for (const auto& p : hull.points) EXPECT_NE(p.objective, "start");
+}
+
+TEST(ExactInnerHull, RejectsBadOptionsAndShapes) {
+  const auto inst = testing::MakeRandomHwInstance(3);
+  const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+  auto solver = MakeLpSolver("clp");
+  InnerHullOptions options;
+  std::string error;
+  options.restarts = -1;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("restarts"), std::string::npos);
+  EXPECT_THROW(ComputeInnerHull(data, BoxAround(inst.theta, 1.0), inst.theta, options, *solver), std::invalid_argument);
+  options = {};
+  options.time_limit_seconds = 0;
+  EXPECT_FALSE(options.IsValid(&error));
+  options = {};
+  EXPECT_THROW(ComputeInnerHull(data, BoxAround(inst.theta, 1.0), {1.0}, options, *solver), std::invalid_argument);
 }
 
 }  // namespace
