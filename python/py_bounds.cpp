@@ -8,6 +8,9 @@
 
 #include "python/py_convert.hpp"
 #include "python/py_module.hpp"
+#include "exact/exact_report.hpp"
+#include "exact/two_stage.hpp"
+#include "relax/bounds_report.hpp"
 #include "relax/box_split.hpp"
 #include "relax/set_membership.hpp"
 #include "sdp/job_executor.hpp"
@@ -98,10 +101,12 @@ struct BoundsArgs {
   bool order_given = false;  // false: the minimal order of the horizon
   relax::BoundsOptions options;
   relax::AutoSplitOptions auto_split;
+  std::string set = "dss";  // "dss" or "exact" (the exact set D inside the D^ss(n) box)
+  exact::ExactBoundsOptions exact;
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
-                  py::object progress, const std::string& source) {
+                  py::object progress, const std::string& source, bool report) {
   relax::HwData data;
   data.source = source;
   data.u = ToVector(u, "u");
@@ -150,6 +155,34 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
                     {"proper", !a.structure.strictly_proper},
                     {"input_basis", a.input_basis},
                     {"output_basis", a.output_basis}};
+  if (a.set == "exact" && !summary.invalidated()) {
+    a.exact.executor = a.options.executor;
+    a.exact.run_dir = a.options.run_dir;
+    a.exact.parameters = a.options.parameters;
+    const exact::ExactBoundsSummary exact_summary = WithoutGil([&] {
+      return exact::ComputeExactBounds(a.exact, a.structure, data, exact::StartBoxFromOuter(summary, set));
+    });
+    nlohmann::json e = exact::ExactResultJson(exact_summary, j, summary, {});
+    if (report) {
+      exact::ExactReportOptions r;
+      for (const auto& iv : exact::StartBoxFromOuter(summary, set)) r.outer.emplace_back(iv.lo, iv.hi);
+      r.outer_label = fmt::format("D^ss({})", a.horizon);
+      r.stage1_seconds = summary.wall_seconds;
+      r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}", a.structure.na, a.structure.nb,
+                                  a.input_basis, a.output_basis);
+      e["full_report"] = exact::ExactReport(exact_summary, r);
+    }
+    return ToPython(e);
+  }
+  j["set"] = "dss";
+  if (report) {  // the text the CLI prints after a run
+    relax::BoundsReportOptions r;
+    r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", a.structure.na,
+                                a.structure.nb, a.input_basis, a.output_basis, a.horizon);
+    r.verify = a.options.generation.verify.enabled;
+    j["brief_report"] = relax::BriefReport(summary, r);
+    j["full_report"] = relax::FullReport(summary, r);
+  }
   return ToPython(j);
 }
 
@@ -168,8 +201,14 @@ void DefineBounds(py::module_& m) {
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
          int row_block_order, int stopped_short_refinements, int endpoint_refinements, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
-         py::object progress, std::string source) {
+         py::object progress, std::string source, bool report, std::string set, int lp_budget, int sweeps) {
         BoundsArgs a;
+        if (set != "dss" && set != "exact")
+          throw py::value_error(fmt::format("set '{}' unknown; expected 'dss' or 'exact'", set));
+        a.set = set;
+        a.exact.search.lp_budget = lp_budget;
+        a.exact.sweeps = sweeps;
+        if (std::string error; !a.exact.IsValid(&error)) throw py::value_error(error);
         a.structure.na = na;
         a.structure.nb = nb;
         a.structure.strictly_proper = strictly_proper;
@@ -202,7 +241,7 @@ void DefineBounds(py::module_& m) {
         op.generation.add_per_round = add_per_round;
         op.generation.violation_tolerance = violation_tolerance;
         op.generation.verify.enabled = verify;
-        return Bounds(u, y, noise_bound, std::move(a), box, split, std::move(progress), source);
+        return Bounds(u, y, noise_bound, std::move(a), box, split, std::move(progress), source, report);
       },
       R"doc(Guaranteed parameter intervals of a Hammerstein-Wiener model from a recording (paper 001), as
 `hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
@@ -219,7 +258,12 @@ progress: called as progress(dict(phase, done, total, from_cache, elapsed_second
 (done/total count the jobs still to run; from_cache those read from run_dir).
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
-its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
+its worker processes; with run_dir a rerun resumes from the finished jobs.
+set: "dss" (the default: D^ss(n)) or "exact": the exact set D bounded inside the D^ss(n) box (CLI --set exact;
+docs/exact_set.md); lp_budget and sweeps are the CLI's --lp-budget and --sweeps. With "exact" the dict has
+"set": "exact", intervals of D (with the inner hull), "outer_set_intervals", "stage2" counts and "assumption".
+report: also return the text `hwbounds bounds` prints, as "brief_report" (the interval table and warnings, or the
+verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the bounds came from).)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
       py::arg("input_basis") = "poly:3", py::arg("output_basis") = "poly:3", py::arg("horizon") = 2,
       py::arg("order") = py::none(), py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
@@ -237,7 +281,9 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("stopped_short_refinements") = o.stopped_short_refinements,
       py::arg("endpoint_refinements") = o.endpoint_refinements, py::arg("max_rounds") = g.max_rounds,
       py::arg("add_per_round") = g.add_per_round, py::arg("violation_tolerance") = g.violation_tolerance,
-      py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data");
+      py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data",
+      py::arg("report") = false, py::arg("set") = "dss",
+      py::arg("lp_budget") = exact::ObjectiveSearchOptions{}.lp_budget, py::arg("sweeps") = exact::ExactBoundsOptions{}.sweeps);
 }
 
 }  // namespace hw::python

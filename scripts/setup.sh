@@ -14,4 +14,10 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"
 fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$(nproc)"
+# The build's lines go to build/build.log (hundreds of them); on a failure its end is shown.
+echo "building hwbounds (log: build/build.log) ..."
+if ! cmake --build build -j"$(nproc)" > build/build.log 2>&1; then
+  tail -n 40 build/build.log
+  echo "the build failed: build/build.log has its whole output" >&2
+  exit 1
+fi
