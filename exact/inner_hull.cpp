@@ -162,7 +162,9 @@ InnerHull ComputeInnerHull(const LiftedData& data, const ParamBox& box, const st
                                             box.size(), start.size(), n));
   HullSearch search(data, box, options, solver);
   const MembershipResult at_start = CheckMembership(data, start, solver);
-  const bool start_in_d = at_start.member;
+  bool start_in_box = true;
+  for (int k = 0; k < n; ++k) start_in_box = start_in_box && box[k].contains(start[k]);
+  const bool start_in_d = at_start.member && start_in_box;  // the hull's points stay in the box
   if (start_in_d) search.Add({start, at_start.initial_state, at_start.slack, "start"});
   const std::vector<double> z0 = at_start.initial_state.empty()
                                      ? std::vector<double>(InitialStateSize(data), 0.0)

@@ -199,6 +199,22 @@ TEST(ExactInnerHull, FindsPointsOfDFromAStartOutsideIt) {
   for (const auto& p : hull.points) EXPECT_NE(p.objective, "start");
 }
 
+TEST(ExactInnerHull, AStartOutsideTheBoxIsNotAPointOfTheHull) {
+  const LiftedData data = BundledRecording();
+  auto solver = MakeLpSolver("clp");
+  const auto truth = CeroneExample::TrueParameters();
+  ParamBox box(8, Interval(-10.0, 10.0));
+  box[0] = Interval(0.41, 10.0);  // gamma2: the truth 0.4 is outside, D reaches 0.437
+  box[4] = Interval(1.79, 1.81);
+  box[5] = Interval(0.89, 0.91);
+  ASSERT_TRUE(CheckMembership(data, truth, *solver).member);
+  InnerHullOptions options;
+  options.restarts = 0;
+  const InnerHull hull = ComputeInnerHull(data, box, truth, options, *solver);
+  ExpectCertifiedHull(data, box, hull, *solver, "bundled recording, gamma2 >= 0.41");
+  for (const auto& p : hull.points) EXPECT_NE(p.objective, "start");
+}
+
 TEST(ExactInnerHull, RejectsBadOptionsAndShapes) {
   const auto inst = testing::MakeRandomHwInstance(3);
   const LiftedData data = MakeLiftedData(inst.structure, inst.data);
