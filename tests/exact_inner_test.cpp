@@ -215,6 +215,22 @@ TEST(ExactInnerHull, AStartOutsideTheBoxIsNotAPointOfTheHull) {
   for (const auto& p : hull.points) EXPECT_NE(p.objective, "start");
 }
 
+TEST(ExactInnerHull, IsAFunctionOfItsInputs) {
+  testing::RandomHwOptions gen;
+  gen.max_samples = 150;
+  const auto inst = testing::MakeRandomHwInstance(2, gen);
+  const LiftedData data = MakeLiftedData(inst.structure, inst.data);
+  auto solver = MakeLpSolver("clp");
+  InnerHullOptions options;
+  options.restarts = 1;
+  const ParamBox box = BoxAround(inst.theta, 1.0);
+  const InnerHull first = ComputeInnerHull(data, box, inst.theta, options, *solver);
+  const InnerHull second = ComputeInnerHull(data, box, inst.theta, options, *solver);
+  EXPECT_EQ(first.ranges, second.ranges) << inst.description;
+  ASSERT_EQ(first.points.size(), second.points.size()) << inst.description;
+  for (std::size_t i = 0; i < first.points.size(); ++i) EXPECT_EQ(first.points[i].theta, second.points[i].theta);
+}
+
 TEST(ExactInnerHull, RejectsBadOptionsAndShapes) {
   const auto inst = testing::MakeRandomHwInstance(3);
   const LiftedData data = MakeLiftedData(inst.structure, inst.data);
