@@ -248,7 +248,8 @@ BandNlpResult SolveOnSamples(const LiftedData& data, const ParamBox& box, const 
 }
 
 // Band margins min(z_t - lo_t, hi_t - z_t) of every sample at (theta, initial state).
-std::vector<double> Margins(const LiftedData& data, const std::vector<double>& theta, const std::vector<double>& initial) {
+std::vector<double> Margins(const LiftedData& data, const std::vector<double>& theta,
+                            const std::vector<double>& initial) {
   const ModelParameters m = DecodeTheta(data, theta);
   const BandEnds bands = ComputeBandEnds(data, m);
   const std::vector<double> z = SimulateOutput(data, m, InputSignal(data, m), initial);
@@ -296,7 +297,8 @@ BandNlpResult SolveBandNlp(const LiftedData& data, const ParamBox& box, const Ba
     if (!result.returned || static_cast<int>(samples.size()) == N) return result;
     const std::vector<int> left = TightestSamples(Margins(data, result.theta, result.initial_state), taken,
                                                   0.5 * request.margin, 2 * batch);
-    current.cpu_seconds = request.cpu_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+    const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+    current.cpu_seconds = request.cpu_seconds - spent;
     if (left.empty() || current.cpu_seconds <= 0) return result;
     take(left);
     current.theta = result.theta;

@@ -161,7 +161,10 @@ void ExpectCertifiedHull(const LiftedData& data, const ParamBox& box, const Inne
   for (int k = 0; k < n; ++k) {
     ASSERT_TRUE(hull.ranges[k].has_value()) << what;
     bool low = false, high = false;
-    for (const auto& p : hull.points) low |= p.theta[k] == hull.ranges[k]->first, high |= p.theta[k] == hull.ranges[k]->second;
+    for (const auto& p : hull.points) {
+      low |= p.theta[k] == hull.ranges[k]->first;
+      high |= p.theta[k] == hull.ranges[k]->second;
+    }
     EXPECT_TRUE(low && high) << what << ": the range of " << data.layout.names[k] << " is not attained by a point";
   }
 }
