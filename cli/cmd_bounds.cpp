@@ -13,8 +13,8 @@
 #include "core/output_files.hpp"
 #include "core/progress_throttle.hpp"
 #include "core/recording.hpp"
-#include "relax/box_split.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/box_split.hpp"
+#include "dss/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::cli {
@@ -37,7 +37,7 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
     if (!(in >> lo >> comma >> hi) || comma != ',' || !(in >> std::ws).eof())
       throw InputError(fmt::format("--box '{}': expected LO,HI (every parameter) or NAME=LO,HI", spec));
     RequireOption(fmt::format("--box '{}'", spec),
-                  [&](std::string* e) { return relax::ValidBoxEntry(target, lo, hi, names, e); });
+                  [&](std::string* e) { return dss::ValidBoxEntry(target, lo, hi, names, e); });
     for (std::size_t i = 0; i < names.size(); ++i)
       if (target.empty() || names[i] == target) box[i] = {lo, hi};
   }
@@ -62,8 +62,8 @@ std::vector<double> parse_list(const std::string& text, const std::string& what)
 
 // "--split gamma2=0" or "--split a1=1.7,1.8 --split b1=0": the prior box is cut at these values (one entry per
 // parameter). The text's syntax is checked here, the values against the box by the library's ValidBoxCuts.
-std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
-  std::vector<relax::BoxCut> cuts;
+std::vector<dss::BoxCut> parse_split(const std::vector<std::string>& specs) {
+  std::vector<dss::BoxCut> cuts;
   for (const auto& spec : specs) {
     const auto eq = spec.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
@@ -85,18 +85,18 @@ struct BoundsCliOptions {
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
   bool proper = false, no_cheap = false, no_edge_witnesses = false, no_moment_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verify = false, no_verify = false;
   int contraction_passes = 0;
-  int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
+  int stopped_short_refinements = dss::BoundsOptions{}.stopped_short_refinements;
   int endpoint_refinements = 0;
   int row_block_order = -1;
   int auto_split = 0;
 };
 
-relax::HwData ReadData(const BoundsCliOptions& o) {
+dss::HwData ReadData(const BoundsCliOptions& o) {
   std::vector<std::string> columns = {o.u_col, o.y_col};
   if (!o.noise_col.empty()) columns.push_back(o.noise_col);
   // A time column (t=VAR, or a CSV column t) is checked and not used: the model runs on the sample index.
   const CsvTable table = read_recording(o.data, columns, {"t"});
-  relax::HwData data;
+  dss::HwData data;
   data.source = o.data;
   data.lines = table.lines;
   data.u = table.column(o.u_col);
@@ -105,16 +105,16 @@ relax::HwData ReadData(const BoundsCliOptions& o) {
     data.noise_bound = table.column(o.noise_col);
   } else {
     if (!o.noise_bound_given) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
-    RequireOption("--noise-bound", [&](std::string* e) { return relax::ValidNoiseBound(o.noise_bound, e); });
+    RequireOption("--noise-bound", [&](std::string* e) { return dss::ValidNoiseBound(o.noise_bound, e); });
     data.noise_bound.assign(data.y.size(), o.noise_bound);
   }
   return data;
 }
 
-relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
-  relax::HwStructure structure;
-  structure.input_basis = relax::parse_basis(o.input_basis);
-  structure.output_basis = relax::parse_basis(o.output_basis);
+dss::HwStructure ReadStructure(const BoundsCliOptions& o) {
+  dss::HwStructure structure;
+  structure.input_basis = dss::parse_basis(o.input_basis);
+  structure.output_basis = dss::parse_basis(o.output_basis);
   structure.na = o.na;
   structure.nb = o.nb;
   structure.strictly_proper = !o.proper;
@@ -125,33 +125,33 @@ relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
 
 // The option values the library checks (the Python module's checks, with the same messages), before any work.
 void CheckBoundsOptions(const BoundsCliOptions& o) {
-  RequireOption("--horizon", [&](std::string* e) { return relax::ValidHorizon(o.horizon, e); });
-  if (o.order_given) RequireOption("--order", [&](std::string* e) { return relax::ValidOrder(o.order, o.horizon, e); });
-  RequireOption("--solver", [&](std::string* e) { return relax::ValidBoundsSolver(o.solver, e); });
-  RequireOption("--threads", [&](std::string* e) { return relax::ValidThreads(o.threads, e); });
+  RequireOption("--horizon", [&](std::string* e) { return dss::ValidHorizon(o.horizon, e); });
+  if (o.order_given) RequireOption("--order", [&](std::string* e) { return dss::ValidOrder(o.order, o.horizon, e); });
+  RequireOption("--solver", [&](std::string* e) { return dss::ValidBoundsSolver(o.solver, e); });
+  RequireOption("--threads", [&](std::string* e) { return dss::ValidThreads(o.threads, e); });
   RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
-  RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
-  RequireOption("--row-block-order", [&](std::string* e) { return relax::ValidBlockOrderCap(o.row_block_order, e); });
+  RequireOption("--contract-passes", [&](std::string* e) { return dss::ValidContractionPasses(o.contraction_passes, e); });
+  RequireOption("--row-block-order", [&](std::string* e) { return pop::ValidBlockOrderCap(o.row_block_order, e); });
   RequireOption("--stopped-short-refinements",
-                [&](std::string* e) { return relax::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
+                [&](std::string* e) { return dss::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
   RequireOption("--endpoint-refinements",
-                [&](std::string* e) { return relax::ValidEndpointRefinements(o.endpoint_refinements, e); });
-  RequireOption("--auto-split", [&](std::string* e) { return relax::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
+                [&](std::string* e) { return dss::ValidEndpointRefinements(o.endpoint_refinements, e); });
+  RequireOption("--auto-split", [&](std::string* e) { return dss::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
-std::string SolverText(const relax::BoundsOptions& options) {
+std::string SolverText(const dss::BoundsOptions& options) {
   if (options.solver != "auto") return options.solver;
   std::vector<std::string> parts;
   for (int d = std::min(options.order, 2); d <= options.order; ++d)  // the cheap pass runs at order 2 at most
     parts.push_back(fmt::format("{} at order {}",
-                                relax::SolverForOrder("auto", d, options.generation.block_order_cap), d));
+                                dss::SolverForOrder("auto", d, options.generation.block_order_cap), d));
   return fmt::format("auto ({})", fmt::join(parts, ", "));
 }
 
-relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
-  relax::BoundsOptions options;
-  options.order = o.order_given ? o.order : relax::MinimalOrder(o.horizon);
+dss::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
+  dss::BoundsOptions options;
+  options.order = o.order_given ? o.order : dss::MinimalOrder(o.horizon);
   options.solver = o.solver;
   options.threads = o.threads;
   options.executor = sdp::MakeExecutor(o.executor, o.threads);
@@ -175,7 +175,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
 }
 
 // The interval table; returns whether every given true value lies inside its interval.
-bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::string>& names,
+bool PrintIntervals(const dss::BoundsSummary& summary, const std::vector<std::string>& names,
                     const std::vector<double>& truth) {
   fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {:<10} {:>19}  {:<25}  {}\n", "parameter", "lower", "upper", "half-width",
              "verified", "correction lo/up", "feasible points reach", "status");
@@ -206,7 +206,7 @@ bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::
 }
 
 // How one orthant was proven empty, for a person: "LP screen, verified in interval arithmetic".
-std::string CertificateText(const relax::EmptinessCertificate& c) {
+std::string CertificateText(const dss::EmptinessCertificate& c) {
   const std::string how = c.kind == "lp"               ? "LP screen infeasible"
                           : c.kind == "relaxation"     ? fmt::format("order {} relaxation infeasible", c.order)
                           : c.kind == "pieces"         ? "proven empty in every piece of the split box"
@@ -216,7 +216,7 @@ std::string CertificateText(const relax::EmptinessCertificate& c) {
 }
 
 // The verdict of an empty feasible set: what it means, which certificates prove it, where to look next.
-void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptions& o) {
+void PrintInvalidation(const dss::BoundsSummary& summary, const BoundsCliOptions& o) {
   fmt::print("\nVERDICT: model invalidated. No parameter in the prior box explains the data within the noise bound: "
              "the model class (na = {}, nb = {}, input basis {}, output basis {}, horizon {}) or the noise bound is "
              "wrong.\n",
@@ -239,7 +239,7 @@ void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptio
 }
 
 // One line per piece of a split box: its box side(s) that differ from the prior box, and what it gave.
-void PrintPieces(const relax::BoundsSummary& summary) {
+void PrintPieces(const dss::BoundsSummary& summary) {
   if (summary.pieces.empty()) return;
   fmt::print("\nthe prior box split into {} pieces; the intervals above are the hull over the pieces:\n",
              summary.pieces.size());
@@ -266,7 +266,7 @@ void PrintPieces(const relax::BoundsSummary& summary) {
 
 // One line per automatic round: the cut it added, the box it ran in (the sides the earlier rounds proved), and
 // what it gave.
-void PrintAutoSplitRounds(const relax::BoundsSummary& summary) {
+void PrintAutoSplitRounds(const dss::BoundsSummary& summary) {
   if (summary.auto_split.is_null()) return;
   const auto& rounds = summary.auto_split.at("rounds");
   fmt::print("\nautomatic cuts: {} round(s) after the first run ({}); each bounds D^ss(n) in the prior box, the "
@@ -292,8 +292,8 @@ void PrintAutoSplitRounds(const relax::BoundsSummary& summary) {
 
 // Where the relaxation may overestimate most: the largest part of an interval no certified point reaches, from
 // 10 % of its width on, with the cut that bounds that part on its own.
-void PrintUnwitnessedPart(const relax::BoundsSummary& summary) {
-  const auto part = relax::LargestUnwitnessedPart(summary);
+void PrintUnwitnessedPart(const dss::BoundsSummary& summary) {
+  const auto part = dss::LargestUnwitnessedPart(summary);
   if (!part || part->fraction < 0.1) return;
   fmt::print("\nlargest unwitnessed part: no certified feasible point has {} in {} ({:.0f}% of its interval); the "
              "relaxation may overestimate there. A cut just {} {:.6g} (--split {}=VALUE, or --auto-split 1 to place it) "
@@ -304,7 +304,7 @@ void PrintUnwitnessedPart(const relax::BoundsSummary& summary) {
              100 * part->fraction, part->below ? "below" : "above", part->witnessed, part->parameter);
 }
 
-void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std::string>& names, bool verify) {
+void PrintRunSummary(const dss::BoundsSummary& summary, const std::vector<std::string>& names, bool verify) {
   fmt::print("\nprior box (assumption): ");
   for (std::size_t i = 0; i < names.size(); ++i)
     fmt::print("{}{} in [{}, {}]", i ? ", " : "", names[i], summary.box[i].first, summary.box[i].second);
@@ -365,7 +365,7 @@ void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std:
                summary.solve_seconds > 0 ? 100 * summary.verify_seconds / summary.solve_seconds : 0.0);
 }
 
-void PrintWarnings(const relax::BoundsSummary& summary, bool verify) {
+void PrintWarnings(const dss::BoundsSummary& summary, bool verify) {
   if (!summary.all_guaranteed())
     fmt::print("WARNING: some endpoints are conservative fallbacks (still valid bounds) or floating-point bounds that "
                "verification could not prove (see notes and the verified column).\n");
@@ -380,7 +380,7 @@ void PrintWarnings(const relax::BoundsSummary& summary, bool verify) {
 }
 
 // The result JSON; an invalidated model has "invalidated": true and null interval values.
-nlohmann::json ResultJson(const relax::BoundsSummary& summary, const BoundsCliOptions& o, const relax::HwOuterSet& set,
+nlohmann::json ResultJson(const dss::BoundsSummary& summary, const BoundsCliOptions& o, const dss::HwOuterSet& set,
                           const std::vector<double>& truth, bool covered) {
   auto j = summary.to_json();  // "invalidated", the verdict, null intervals and each orthant's certificate
   j["data"] = o.data;
@@ -481,16 +481,16 @@ void AddBoundsCommand(CLI::App& app) {
     CheckBoundsOptions(*o);
     if (!o->json_out.empty()) CheckOutputFile(o->json_out, "--json");
     if (!o->run_dir.empty()) CheckOutputDirectory(o->run_dir, "--run-dir");
-    const relax::HwData data = ReadData(*o);
-    const relax::HwStructure structure = ReadStructure(*o);
-    const auto names = relax::MakeLayout(structure).names;
-    const relax::BoundsOptions options = MakeBoundsOptions(*o);
-    const relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
-    const std::vector<relax::BoxCut> cuts = parse_split(o->split);
-    RequireOption("--split", [&](std::string* e) { return relax::ValidBoxCuts(cuts, names, set.box(), e); });
+    const dss::HwData data = ReadData(*o);
+    const dss::HwStructure structure = ReadStructure(*o);
+    const auto names = dss::MakeLayout(structure).names;
+    const dss::BoundsOptions options = MakeBoundsOptions(*o);
+    const dss::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
+    const std::vector<dss::BoxCut> cuts = parse_split(o->split);
+    RequireOption("--split", [&](std::string* e) { return dss::ValidBoxCuts(cuts, names, set.box(), e); });
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
-      relax::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
+      dss::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
       return;
     }
     std::vector<double> truth;
@@ -504,7 +504,7 @@ void AddBoundsCommand(CLI::App& app) {
                data.y.size(), o->data, o->na, o->nb, o->horizon, options.order, names.size(), set.num_orthants(),
                SolverText(options), options.executor->name(), options.executor->workers());
     ProgressThrottle throttle(5.0);  // a line per phase start and end, and at most one every 5 s in between
-    auto progress = [o, &throttle](const relax::BoundsProgress& p) {
+    auto progress = [o, &throttle](const dss::BoundsProgress& p) {
       if (o->quiet) return;
       if (p.total < 0) {  // a one-off message
         fmt::print(stderr, "{}\n", p.phase);
@@ -515,9 +515,9 @@ void AddBoundsCommand(CLI::App& app) {
                  p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
                  p.elapsed_seconds, p.eta_seconds);
     };
-    relax::AutoSplitOptions auto_split;
+    dss::AutoSplitOptions auto_split;
     auto_split.rounds = o->auto_split;
-    const auto summary = relax::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split, progress);
+    const auto summary = dss::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split, progress);
     const bool invalidated = summary.invalidated();
     bool covered = true;
     if (invalidated) PrintInvalidation(summary, *o);
