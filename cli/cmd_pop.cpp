@@ -20,7 +20,7 @@ void AddPopCommand(CLI::App& app) {
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("PROBLEM", o->problem, "problem JSON (see README: Polynomial problems)")->required();
+  cmd->add_option("PROBLEM", o->problem, "problem JSON (see docs/pop.md)")->required();
   // --order and --solver are checked in the callback by the library's checks (the Python module's messages).
   auto* order = cmd->add_option("--order", o->order, "relaxation order delta, at least the problem's minimal order")
                     ->default_str("minimal");

@@ -3,7 +3,7 @@
 //
 // The pieces cover the box, so the hull of their intervals bounds D^ss(n) in the box as the whole-box run does.
 // It is often much tighter: an orthant whose relaxation cannot exclude a far, empty part of its box in one piece
-// can be proven empty there once that part is a piece of its own (README, "The relaxation gap at δ = 3": on
+// can be proven empty there once that part is a piece of its own (docs/cerone_tables.md, "The relaxation gap at δ = 3": on
 // seed 3 at 31 dB a cut at γ2 = 0 takes γ3's outer/inner half-width ratio from 1.86 to 1.006). A good cut lies
 // where the certified feasible points of a parameter end and its outer interval goes on (the "witnessed" range
 // of a first run).

@@ -1,7 +1,7 @@
 #pragma once
 // Guaranteed parameter intervals of a Hammerstein–Wiener model over D^ss(n) (paper 001, eqs. 22-33).
 //
-// The engine is a pipeline of stages, each in its own file (docs: README, "How the bounds are computed"):
+// The engine is a pipeline of stages, each in its own file (docs/setmembership.md, "How the bounds are computed"):
 //  1. screen orthants   (dss/orthant_screen.hpp): an LP per sign orthant; infeasible (verified) => empty.
 //  2. reduce rows       (dss/row_reduction.hpp):  drop data rows implied by the others (exact at any order).
 //  3. edge witnesses    (dss/edge_witness.hpp):   endpoints at the prior box edge settled by feasible points.

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "dss/bounds_report.hpp"
 #include "dss/box_split.hpp"
 #include "dss/set_membership.hpp"
 #include "python/py_convert.hpp"
@@ -101,7 +102,7 @@ struct BoundsArgs {
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
-                  py::object progress, const std::string& source) {
+                  py::object progress, const std::string& source, bool report) {
   dss::HwData data;
   data.source = source;
   data.u = ToVector(u, "u");
@@ -150,6 +151,14 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
                     {"proper", !a.structure.strictly_proper},
                     {"input_basis", a.input_basis},
                     {"output_basis", a.output_basis}};
+  if (report) {  // the text the CLI prints after a run
+    dss::BoundsReportOptions r;
+    r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", a.structure.na,
+                                a.structure.nb, a.input_basis, a.output_basis, a.horizon);
+    r.verify = a.options.generation.verify.enabled;
+    j["brief_report"] = dss::BriefReport(summary, r);
+    j["full_report"] = dss::FullReport(summary, r);
+  }
   return ToPython(j);
 }
 
@@ -168,7 +177,7 @@ void DefineBounds(py::module_& m) {
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
          int row_block_order, int stopped_short_refinements, int endpoint_refinements, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
-         py::object progress, std::string source) {
+         py::object progress, std::string source, bool report) {
         BoundsArgs a;
         a.structure.na = na;
         a.structure.nb = nb;
@@ -202,7 +211,7 @@ void DefineBounds(py::module_& m) {
         op.generation.add_per_round = add_per_round;
         op.generation.violation_tolerance = violation_tolerance;
         op.generation.verify.enabled = verify;
-        return Bounds(u, y, noise_bound, std::move(a), box, split, std::move(progress), source);
+        return Bounds(u, y, noise_bound, std::move(a), box, split, std::move(progress), source, report);
       },
       R"doc(Guaranteed parameter intervals of a Hammerstein-Wiener model from a recording (paper 001), as
 `hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
@@ -219,7 +228,9 @@ progress: called as progress(dict(phase, done, total, from_cache, elapsed_second
 (done/total count the jobs still to run; from_cache those read from run_dir).
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
-its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
+its worker processes; with run_dir a rerun resumes from the finished jobs.
+report: also return the text `hwbounds bounds` prints, as "brief_report" (the interval table and warnings, or the
+verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the bounds came from).)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
       py::arg("input_basis") = "poly:3", py::arg("output_basis") = "poly:3", py::arg("horizon") = 2,
       py::arg("order") = py::none(), py::kw_only(), py::arg("strictly_proper") = s.strictly_proper,
@@ -237,7 +248,8 @@ its worker processes; with run_dir a rerun resumes from the finished jobs.)doc",
       py::arg("stopped_short_refinements") = o.stopped_short_refinements,
       py::arg("endpoint_refinements") = o.endpoint_refinements, py::arg("max_rounds") = g.max_rounds,
       py::arg("add_per_round") = g.add_per_round, py::arg("violation_tolerance") = g.violation_tolerance,
-      py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data");
+      py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data",
+      py::arg("report") = false);
 }
 
 }  // namespace hw::python

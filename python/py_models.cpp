@@ -42,7 +42,7 @@ void DefineModels(py::module_& m) {
         CheckFiniteOutput(w, source, [](std::size_t t) { return fmt::format("u[{}]", t); });
         return ToArray(w);
       },
-      R"doc(Noise-free output w of a model (a dict in the README's Model JSON format, or the path of such a
+      R"doc(Noise-free output w of a model (a dict in the Model JSON format of docs/input_output.md, or the path of such a
 file) driven by the input u, simulated from rest as `hwbounds simulate` does. A model whose linear block is
 unstable is refused unless allow_unstable (the CLI's --allow-unstable), and an output that overflows double
 precision is an error, both with the CLI's message. Returns a numpy array.)doc",
