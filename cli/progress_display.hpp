@@ -6,7 +6,7 @@
 #include <string>
 
 #include "core/progress_throttle.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
 
 namespace hw::cli {
 
@@ -27,13 +27,13 @@ class ProgressDisplay {
   ProgressDisplay(const ProgressDisplay&) = delete;
   ProgressDisplay& operator=(const ProgressDisplay&) = delete;
 
-  void Show(const relax::BoundsProgress& p);
+  void Show(const dss::BoundsProgress& p);
   // Ends a live line still open, so that what is printed next starts on a line of its own.
   void Finish();
 
  private:
   void ShowMessage(const std::string& text);
-  void ShowLive(const relax::BoundsProgress& p, const std::string& line);
+  void ShowLive(const dss::BoundsProgress& p, const std::string& line);
 
   ProgressMode mode_;
   std::FILE* out_;
@@ -42,6 +42,6 @@ class ProgressDisplay {
 };
 
 // "[phase] 3/20 jobs (+2 from the run directory), elapsed 12 s, ETA 68 s".
-std::string ProgressLine(const relax::BoundsProgress& p);
+std::string ProgressLine(const dss::BoundsProgress& p);
 
 }  // namespace hw::cli

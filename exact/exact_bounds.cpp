@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "dss/bound_jobs.hpp"
 #include "exact/exact_jobs.hpp"
-#include "relax/bound_jobs.hpp"
 
 namespace hw::exact {
 namespace {
@@ -20,7 +20,7 @@ double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 // null: the caller keeps what it concerned (a box stays live; an endpoint falls back to the box edge).
 class JobRunner {
  public:
-  JobRunner(sdp::JobExecutor& executor, const relax::RunCache& cache, const sdp::JobFunction& fn, ExactBoundsSummary& s)
+  JobRunner(sdp::JobExecutor& executor, const dss::RunCache& cache, const sdp::JobFunction& fn, ExactBoundsSummary& s)
       : executor_(executor), cache_(cache), fn_(fn), summary_(s) {}
   // `on_done(done, total)` after each job run here (jobs read from the run directory count as done at once).
   std::vector<nlohmann::json> Run(const std::vector<nlohmann::json>& specs,
@@ -55,7 +55,7 @@ class JobRunner {
 
  private:
   sdp::JobExecutor& executor_;
-  const relax::RunCache& cache_;
+  const dss::RunCache& cache_;
   const sdp::JobFunction& fn_;
   ExactBoundsSummary& summary_;
 };
@@ -127,7 +127,7 @@ std::vector<LiveBox> Prune(const LiftedData& data, const ParamBox& start, const 
   return live;
 }
 
-std::vector<int> WantedParameters(const ExactBoundsOptions& options, const relax::ParameterLayout& lay) {
+std::vector<int> WantedParameters(const ExactBoundsOptions& options, const dss::ParameterLayout& lay) {
   std::vector<int> wanted;
   for (int k = 0; k < lay.count(); ++k)
     if (options.parameters.empty() ||
@@ -260,8 +260,8 @@ nlohmann::json ExactBoundsSummary::to_json() const {
             {"executor", executor}}}};
 }
 
-ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const relax::HwStructure& structure,
-                                      const relax::HwData& data, const ParamBox& start_box,
+ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
+                                      const dss::HwData& data, const ParamBox& start_box,
                                       const std::function<void(const ExactBoundsProgress&)>& progress) {
   const auto t0 = Clock::now();
   std::string error;
@@ -294,7 +294,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const r
   }
   nlohmann::json meta = {{"engine", "exact"}, {"start_box", BoxToJson(start_box)}};
   const std::string key = JobKey(meta.dump() + std::to_string(lifted.num_samples));
-  const relax::RunCache cache(options.run_dir, "exact-" + key, meta);
+  const dss::RunCache cache(options.run_dir, "exact-" + key, meta);
   JobRunner runner(*executor, cache, fn, s);
 
   // 1. prune

@@ -97,8 +97,8 @@ struct ExactBoundsSummary {
   nlohmann::json to_json() const;
 };
 
-ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const relax::HwStructure& structure,
-                                      const relax::HwData& data, const ParamBox& start_box,
+ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
+                                      const dss::HwData& data, const ParamBox& start_box,
                                       const std::function<void(const ExactBoundsProgress&)>& progress = {});
 
 // The assumption's statement, for --help, summaries and JSON.

@@ -6,7 +6,7 @@
 
 namespace hw::exact {
 
-ParamBox StartBoxFromOuter(const relax::BoundsSummary& outer, const relax::HwOuterSet& set) {
+ParamBox StartBoxFromOuter(const dss::BoundsSummary& outer, const dss::HwOuterSet& set) {
   const auto& names = set.layout().names;
   ParamBox box;
   for (std::size_t k = 0; k < names.size(); ++k) box.emplace_back(set.box()[k].first, set.box()[k].second);
@@ -19,7 +19,7 @@ ParamBox StartBoxFromOuter(const relax::BoundsSummary& outer, const relax::HwOut
 }
 
 nlohmann::json ExactResultJson(const ExactBoundsSummary& exact, const nlohmann::json& outer_json,
-                               const relax::BoundsSummary& outer, const std::vector<double>& truth) {
+                               const dss::BoundsSummary& outer, const std::vector<double>& truth) {
   nlohmann::json j = exact.to_json();
   j["set"] = "exact";
   j["outer_set_intervals"] = outer_json.at("intervals");

@@ -10,26 +10,26 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
+#include "dss/hw_outer_set.hpp"
 #include "exact/inner_hull.hpp"
 #include "exact/lifted_lp.hpp"
 #include "exact/lp_solver.hpp"
 #include "exact/membership.hpp"
 #include "random_hw.hpp"
-#include "relax/hw_outer_set.hpp"
 
 namespace hw::exact {
 namespace {
 
 LiftedData CeroneData(uint64_t seed, int samples, double snr_db) {
   const auto ex = SimulateCeroneExample(seed, samples, snr_db);
-  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  return MakeLiftedData(relax::CeroneExampleStructure(), data);
+  dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  return MakeLiftedData(dss::CeroneExampleStructure(), data);
 }
 
 LiftedData BundledRecording() {
   const auto table = read_csv(std::string(HW_SOURCE_DIR) + "/paper_examples/data/cerone2011_N300.csv");
-  relax::HwData data{table.column("u"), table.column("y"), table.column("noise_bound"), table.source};
-  return MakeLiftedData(relax::CeroneExampleStructure(), data);
+  dss::HwData data{table.column("u"), table.column("y"), table.column("noise_bound"), table.source};
+  return MakeLiftedData(dss::CeroneExampleStructure(), data);
 }
 
 TEST(ExactMembership, TruthOfANearlyNoiseFreeRecordIsAMemberAndAFarPointIsNot) {
@@ -85,7 +85,7 @@ TEST(RandomHw, CoversTheStructuresAndIsAFunctionOfTheSeed) {
   int proper = 0, strictly = 0, tanh_inputs = 0, cubic_outputs = 0;
   for (uint64_t seed = 1; seed <= 100; ++seed) {
     const auto inst = testing::MakeRandomHwInstance(seed);
-    const auto layout = relax::MakeLayout(inst.structure);
+    const auto layout = dss::MakeLayout(inst.structure);
     ASSERT_EQ(static_cast<int>(inst.theta.size()), layout.count()) << inst.description;
     (inst.structure.strictly_proper ? strictly : proper) += 1;
     tanh_inputs += inst.structure.input_basis.size() == 2 && inst.structure.input_basis[1].name == "tanh";
