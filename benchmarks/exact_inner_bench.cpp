@@ -13,7 +13,7 @@
 #include "exact/lifted_lp.hpp"
 #include "exact/lp_solver.hpp"
 #include "exact/membership.hpp"
-#include "relax/hw_outer_set.hpp"
+#include "dss/hw_outer_set.hpp"
 
 namespace {
 
@@ -39,8 +39,8 @@ int main(int argc, char** argv) {
   auto solver = hw::exact::MakeLpSolver("clp");
   for (int N : samples) {
     const auto ex = hw::SimulateCeroneExample(seed, N, snr);
-    hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
-    const auto lifted = hw::exact::MakeLiftedData(hw::relax::CeroneExampleStructure(), data);
+    hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+    const auto lifted = hw::exact::MakeLiftedData(hw::dss::CeroneExampleStructure(), data);
     std::vector<double> times;
     double slack = 0.0;
     for (int r = 0; r < repeats; ++r) {
