@@ -344,13 +344,9 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     const std::string phase = fmt::format("bound (sweep {} of {}, endpoints)", sweep + 1, options.sweeps);
     ParamBox sweep_start = start_box;
     for (int k = 0; k < lay.count(); ++k) sweep_start[k] = Interval(s.intervals[k].lower.value, s.intervals[k].upper.value);
-    std::vector<ParamBox> sweep_boxes;
-    for (const auto& b : boxes) {
-      ParamBox c = b;
-      for (int k = 0; k < lay.count(); ++k)
-        if (k < lay.a_begin || k >= lay.a_begin + structure.na) c[k] = sweep_start[k];
-      sweep_boxes.push_back(c);
-    }
+    // Each endpoint's search starts from the live hull (one box): it halves only where its bound is worst, which
+    // costs fewer LPs than bounding every live box of the pruning search first.
+    const std::vector<ParamBox> sweep_boxes = {sweep_start};
     BoundSweep(lifted, sweep_start, sweep_boxes, inner ? &*inner : nullptr, options.target_ratio, runner, s, s.intervals,
                [&](int done, int total) {
                  if (progress) progress({phase, done, total, "", SecondsSince(t0)});
