@@ -5,6 +5,7 @@
 #include <fstream>
 #include <random>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@
 #include "exact/membership.hpp"
 #include "exact/safe_bound.hpp"
 #include "random_hw.hpp"
+#include "test_support.hpp"
 
 namespace hw::exact {
 namespace {
@@ -208,6 +210,51 @@ TEST(ExactBounds, ARecordNoModelOfTheClassExplainsIsInvalidatedWithCertificates)
   EXPECT_FALSE(s.certificates.empty());
   for (const auto& c : s.certificates) EXPECT_GT(c.at("certificate").at("residual_lower_bound").get<double>(), 0.0);
 }
+
+#ifdef HW_CLI_PATH
+TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
+  testing::RandomHwOptions opts;
+  opts.min_samples = 80, opts.max_samples = 80;
+  testing::RandomHwInstance inst;
+  for (uint64_t seed = 1;; ++seed) {  // the first instance of the example's class (na = nb = 1, poly:1 input)
+    inst = testing::MakeRandomHwInstance(seed, opts);
+    if (inst.structure.na == 1 && inst.structure.nb == 1 && inst.structure.strictly_proper &&
+        inst.structure.input_basis.size() == 1 && inst.structure.output_basis.size() == 2)
+      break;
+  }
+  const std::string csv = ::testing::TempDir() + "exact_cli.csv", json = ::testing::TempDir() + "exact_cli.json";
+  {
+    std::ofstream out(csv);
+    out << "u,y,dy\n";
+    out.precision(17);
+    for (std::size_t t = 0; t < inst.data.y.size(); ++t)
+      out << inst.data.u[t] << "," << inst.data.y[t] << "," << inst.data.noise_bound[t] << "\n";
+  }
+  std::string truth;
+  for (double v : inst.theta) truth += (truth.empty() ? "" : ",") + fmt::format("{:.17g}", v);
+  const auto run = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --na 1 --nb 1 --input-basis poly:1 "
+                                      "--output-basis poly:2 --horizon 1 --set exact --lp-budget 4 --sweeps 1 "
+                                      "--threads 1 --quiet --truth {} --json {}",
+                                      csv, truth, json));
+  ASSERT_EQ(run.code, 0) << inst.description << "\n" << run.output;
+  EXPECT_NE(run.output.find("exact set D"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("increases on the data range"), std::string::npos) << run.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("set"), "exact");
+  EXPECT_TRUE(j.at("truth_covered").get<bool>());
+  EXPECT_EQ(j.at("outer_set_intervals").size(), j.at("intervals").size());
+  EXPECT_TRUE(j.at("assumption").at("holds").get<bool>());
+  EXPECT_GT(j.at("stage2").at("lps").get<int>(), 0);
+  for (const auto& iv : j.at("intervals")) {
+    EXPECT_EQ(iv.at("lower").at("verification"), "verified");
+    EXPECT_TRUE(iv.contains("inner")) << iv.dump();
+  }
+  // An unknown set is refused before any work.
+  const auto bad = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --set exactly", csv));
+  EXPECT_EQ(bad.code, 2) << bad.output;
+}
+#endif
 
 }  // namespace
 }  // namespace hw::exact
