@@ -31,6 +31,13 @@ ParamBox BoxAround(const LiftedData& d, const std::vector<double>& theta, double
   return box;
 }
 
+// A random instance of exactly n samples.
+testing::RandomHwInstance InstanceOf(uint64_t seed, int samples) {
+  testing::RandomHwOptions opts;
+  opts.min_samples = samples, opts.max_samples = samples;
+  return testing::MakeRandomHwInstance(seed, opts);
+}
+
 ExactBoundsOptions SmallRunOptions() {
   ExactBoundsOptions o;
   o.executor = std::make_shared<sdp::InProcessExecutor>();
@@ -66,9 +73,7 @@ TEST(SafeBound, EqualsTheLpOptimumOnASmallProblemAndNeverExceedsIt) {
 }
 
 TEST(LiftedLp, TheTruthsBoxIsNeverProvenEmptyAndABoxFarAwayIs) {
-  testing::RandomHwOptions opts;
-  opts.min_samples = 80, opts.max_samples = 80;
-  const auto inst = testing::MakeRandomHwInstance(7, opts);
+  const auto inst = InstanceOf(7, 80);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
   ClpSolver clp;
   BoxEvaluationOptions ev;
@@ -105,9 +110,7 @@ class LyingSolver : public LpSolver {
 };
 
 TEST(BranchAndBound, ALyingLpBackendNeitherDropsTheTruthsBoxNorExcludesTheTruth) {
-  testing::RandomHwOptions opts;
-  opts.min_samples = 60, opts.max_samples = 60;
-  const auto inst = testing::MakeRandomHwInstance(11, opts);
+  const auto inst = InstanceOf(11, 60);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
   const ParamBox start = BoxAround(d, inst.theta, 0.05, 0.5);
   BoxEvaluationOptions ev;
@@ -177,9 +180,7 @@ TEST(ExactSoundness, RandomSystemsSeeds51To75) { CheckSoundness(51, 25); }
 TEST(ExactSoundness, RandomSystemsSeeds76To100) { CheckSoundness(76, 25); }
 
 TEST(ExactBounds, NarrowerThanTheStartBoxAndTheSameOnEveryExecutor) {
-  testing::RandomHwOptions opts;
-  opts.min_samples = 80, opts.max_samples = 80;
-  const auto inst = testing::MakeRandomHwInstance(5, opts);
+  const auto inst = InstanceOf(5, 80);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
   const ParamBox start = BoxAround(d, inst.theta, 0.05, 1.0);
   ExactBoundsOptions o = SmallRunOptions();
@@ -198,9 +199,7 @@ TEST(ExactBounds, NarrowerThanTheStartBoxAndTheSameOnEveryExecutor) {
 }
 
 TEST(ExactBounds, ARecordNoModelOfTheClassExplainsIsInvalidatedWithCertificates) {
-  testing::RandomHwOptions opts;
-  opts.min_samples = 60, opts.max_samples = 60;
-  auto inst = testing::MakeRandomHwInstance(9, opts);
+  auto inst = InstanceOf(9, 60);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
   // The start box excludes the truth's a_1 by far: nothing in it explains the record.
   ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
