@@ -102,7 +102,7 @@ struct BoundsArgs {
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
-                  py::object progress, const std::string& source, bool report) {
+                  py::object progress, const std::string& source, bool with_report) {
   relax::HwData data;
   data.source = source;
   data.u = ToVector(u, "u");
@@ -151,7 +151,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
                     {"proper", !a.structure.strictly_proper},
                     {"input_basis", a.input_basis},
                     {"output_basis", a.output_basis}};
-  if (report) {  // the text the CLI prints after a run
+  if (with_report) {  // the text the CLI prints after a run
     relax::BoundsReportOptions r;
     r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", a.structure.na,
                                 a.structure.nb, a.input_basis, a.output_basis, a.horizon);
