@@ -13,6 +13,8 @@
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
 #include "core/recording.hpp"
+#include "exact/exact_bounds.hpp"
+#include "exact/exact_report.hpp"
 #include "relax/bounds_report.hpp"
 #include "relax/box_split.hpp"
 #include "relax/set_membership.hpp"
@@ -90,7 +92,36 @@ struct BoundsCliOptions {
   int endpoint_refinements = 0;
   int row_block_order = -1;
   int auto_split = 0;
+  std::string set = "dss";  // which feasible set the intervals bound: dss (D^ss(n)) or exact (D, after D^ss(n))
+  int lp_budget = exact::ObjectiveSearchOptions{}.lp_budget;
+  int sweeps = exact::ExactBoundsOptions{}.sweeps;
 };
+
+// What the bounds of the exact set D need besides the D^ss(n) run: its start box is that run's result.
+exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const relax::BoundsOptions& dss) {
+  exact::ExactBoundsOptions options;
+  options.executor = dss.executor;
+  options.run_dir = o.run_dir;
+  options.parameters = o.params;
+  options.search.lp_budget = o.lp_budget;
+  options.sweeps = o.sweeps;
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  return options;
+}
+
+// The start box of the exact set: the D^ss(n) intervals (valid bounds, also where conservative), the prior box
+// for parameters the run did not bound.
+exact::ParamBox StartBoxFrom(const relax::BoundsSummary& dss, const relax::HwOuterSet& set) {
+  const auto& names = set.layout().names;
+  exact::ParamBox box;
+  for (std::size_t k = 0; k < names.size(); ++k) box.emplace_back(set.box()[k].first, set.box()[k].second);
+  for (const auto& iv : dss.intervals) {
+    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
+    if (k < names.size()) box[k] = exact::Interval(std::max(box[k].lo, iv.lower.value), std::min(box[k].hi, iv.upper.value));
+  }
+  return box;
+}
 
 relax::HwData ReadData(const BoundsCliOptions& o) {
   std::vector<std::string> columns = {o.u_col, o.y_col};
@@ -269,6 +300,14 @@ void AddBoundsCommand(CLI::App& app) {
       ->excludes(verify);
   cmd->add_option("--params", o->params, "only these intervals (names such as a1 b1)")->delimiter(',')->default_str("all");
   cmd->add_option("--truth", o->truth, "comma list of true parameters, to report coverage (simulation studies)");
+  cmd->add_option("--set", o->set,
+                  "which feasible set to bound: dss (D^ss(n) of paper 001, sign orthants and moment relaxations) or "
+                  "exact (the exact set D, one noise sequence for the whole record, bounded by lifted LPs and branch "
+                  "and bound inside the D^ss(n) box; 3-2000 times narrower; docs/exact_set.md). exact assumes the "
+                  "inverse output map increases on the data range")
+      ->check(CLI::IsMember({"dss", "exact"}));
+  cmd->add_option("--lp-budget", o->lp_budget, "--set exact: LPs per endpoint refinement (>= 1)");
+  cmd->add_option("--sweeps", o->sweeps, "--set exact: bounding sweeps, each in the box the previous proved (1..5)");
   cmd->add_option("--json", o->json_out, "write the result as JSON");
   cmd->add_option("--plot", o->plot_out,
                   "draw the intervals as a PNG (gnuplot): each in its prior box and stretched to its own width, with "
@@ -294,7 +333,8 @@ void AddBoundsCommand(CLI::App& app) {
     RequireOption("--split", [&](std::string* e) { return relax::ValidBoxCuts(cuts, names, set.box(), e); });
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
-      relax::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
+      const auto outer = relax::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
+      if (o->set == "exact") exact::ComputeExactBounds(MakeExactOptions(*o, options), structure, data, StartBoxFrom(outer, set));
       return;
     }
     std::vector<double> truth;
@@ -322,12 +362,47 @@ void AddBoundsCommand(CLI::App& app) {
                                      o->input_basis, o->output_basis, o->horizon);
     report.verify = !o->no_verify;
     fmt::print("{}", relax::FullReport(summary, report));
+    nlohmann::json result = ResultJson(summary, *o, set, truth, covered);
+    result["set"] = "dss";
+    bool exact_invalidated = false;
+    if (o->set == "exact" && !invalidated) {
+      std::fflush(stdout);
+      ProgressDisplay exact_display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
+      const auto exact_summary = exact::ComputeExactBounds(
+          MakeExactOptions(*o, options), structure, data, StartBoxFrom(summary, set),
+          [&exact_display](const exact::ExactBoundsProgress& p) {
+            relax::BoundsProgress line;
+            line.phase = fmt::format("exact set: {}{}{}", p.phase, p.detail.empty() ? "" : ": ", p.detail);
+            line.done = line.total = -1;
+            line.elapsed_seconds = p.elapsed_seconds;
+            exact_display.Show(line);
+          });
+      exact_display.Finish();
+      exact::ExactReportOptions exact_report;
+      exact_report.truth = truth;
+      for (const auto& iv : StartBoxFrom(summary, set)) exact_report.outer.emplace_back(iv.lo, iv.hi);
+      exact_report.outer_label = fmt::format("D^ss({})", o->horizon);
+      exact_report.stage1_seconds = summary.wall_seconds;
+      exact_report.model_class = report.model_class + ", noise bound per sample from the recording or --noise-bound";
+      fmt::print("{}", exact::ExactReport(exact_summary, exact_report));
+      nlohmann::json j = exact_summary.to_json();
+      j["set"] = "exact";
+      j["outer_set_intervals"] = result["intervals"];
+      j["outer_set"] = {{"horizon", o->horizon}, {"order", options.order}, {"wall_seconds", summary.wall_seconds}};
+      for (const char* key : {"data", "data_warnings", "structure"}) j[key] = result[key];
+      if (!truth.empty()) {
+        j["truth"] = truth;
+        j["truth_covered"] = exact::TruthInside(exact_summary, truth);
+      }
+      result = j;
+      exact_invalidated = exact_summary.invalidated;
+    }
     OutputFiles outputs;  // all or none, each renamed into place whole
-    if (!o->json_out.empty()) outputs.Add(o->json_out, ResultJson(summary, *o, set, truth, covered).dump(2) + "\n");
+    if (!o->json_out.empty()) outputs.Add(o->json_out, result.dump(2) + "\n");
     if (!o->plot_out.empty()) outputs.Add(o->plot_out, RenderBoundsPlot(summary, truth, plot_terminal));
     outputs.Commit();
     for (const auto& [path, bytes] : outputs.files()) fmt::print("wrote {}\n", path);
-    if (invalidated) throw CommandExit{kExitInvalidated};
+    if (invalidated || exact_invalidated) throw CommandExit{kExitInvalidated};
   });
 }
 

@@ -4,7 +4,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PACKAGES=(cmake g++ make libeigen3-dev libsdp-dev coinor-csdp libsdpa-dev sdpa libdsdp-dev libsuitesparse-dev libcli11-dev
           nlohmann-json3-dev libfmt-dev gnuplot-nox libgtest-dev libbenchmark-dev libopenmpi-dev openmpi-bin
-          coinor-libipopt-dev libglpk-dev libcgal-dev libgmp-dev libmpfr-dev libtbb-dev pkg-config libmatio-dev libhdf5-dev
+          coinor-libipopt-dev coinor-libclp-dev libglpk-dev libcgal-dev libgmp-dev libmpfr-dev libtbb-dev pkg-config libmatio-dev libhdf5-dev
           pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy python3-h5py python3-matplotlib)
 missing=()
 for p in "${PACKAGES[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
