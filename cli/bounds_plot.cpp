@@ -61,7 +61,7 @@ std::string IntervalRows(const dss::BoundsSummary& s, const std::vector<double>&
     const double lo = iv.lower.value, hi = iv.upper.value, t = truth.empty() ? NAN : truth[k];
     rows += fmt::format("{} {} {} {} {} {} {} {} {}\n", n - 1 - r,
                         Quoted(fmt::format("{} in [{:.6g}, {:.6g}]", iv.name, blo, bhi)),
-                        Quoted(std::isfinite(lo) ? fmt::format("[{:.6g}, {:.6g}]", lo, hi) : "empty"),
+                        Quoted(std::isfinite(lo) ? fmt::format("{} [{:.6g}, {:.6g}]", iv.name, lo, hi) : iv.name + " empty"),
                         Fraction(lo, blo, bhi), Fraction(hi, blo, bhi), Fraction(t, blo, bhi),
                         Fraction(iv.witnessed_lower.value_or(NAN), lo, hi),
                         Fraction(iv.witnessed_upper.value_or(NAN), lo, hi), Fraction(t, lo, hi));

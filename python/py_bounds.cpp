@@ -106,7 +106,7 @@ struct BoundsArgs {
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
-                  py::object progress, const std::string& source, bool report) {
+                  py::object progress, const std::string& source, bool with_report) {
   dss::HwData data;
   data.source = source;
   data.u = ToVector(u, "u");
@@ -163,7 +163,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
       return exact::ComputeExactBounds(a.exact, a.structure, data, exact::StartBoxFromOuter(summary, set));
     });
     nlohmann::json e = exact::ExactResultJson(exact_summary, j, summary, {});
-    if (report) {
+    if (with_report) {
       exact::ExactReportOptions r;
       for (const auto& iv : exact::StartBoxFromOuter(summary, set)) r.outer.emplace_back(iv.lo, iv.hi);
       r.outer_label = fmt::format("D^ss({})", a.horizon);
@@ -175,7 +175,7 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
     return ToPython(e);
   }
   j["set"] = "dss";
-  if (report) {  // the text the CLI prints after a run
+  if (with_report) {  // the text the CLI prints after a run
     dss::BoundsReportOptions r;
     r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", a.structure.na,
                                 a.structure.nb, a.input_basis, a.output_basis, a.horizon);
