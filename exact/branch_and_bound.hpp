@@ -35,7 +35,7 @@ struct PruneStop {
 bool PruneSearchDone(const LiftedData& data, const std::vector<ParamBox>& live, int level, const PruneStop& stop);
 
 struct ObjectiveSearchOptions {
-  int lp_budget = 16;              // LPs of one endpoint's refinement
+  int lp_budget = 24;              // LPs of one endpoint's refinement
   double min_relative_width = 1e-9;  // a box narrower than this (relative to the start box) is not halved
   bool IsValid(std::string* error) const;
 };
