@@ -13,11 +13,12 @@
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
 #include "core/recording.hpp"
+#include "exact/exact_bounds.hpp"
+#include "exact/exact_report.hpp"
+#include "exact/two_stage.hpp"
 #include "dss/bounds_report.hpp"
 #include "dss/box_split.hpp"
 #include "dss/set_membership.hpp"
-#include "exact/exact_bounds.hpp"
-#include "exact/exact_report.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::cli {
@@ -108,19 +109,6 @@ exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss:
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
   return options;
-}
-
-// The start box of the exact set: the D^ss(n) intervals (valid bounds, also where conservative), the prior box
-// for parameters the run did not bound.
-exact::ParamBox StartBoxFrom(const dss::BoundsSummary& dss, const dss::HwOuterSet& set) {
-  const auto& names = set.layout().names;
-  exact::ParamBox box;
-  for (std::size_t k = 0; k < names.size(); ++k) box.emplace_back(set.box()[k].first, set.box()[k].second);
-  for (const auto& iv : dss.intervals) {
-    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
-    if (k < names.size()) box[k] = exact::Interval(std::max(box[k].lo, iv.lower.value), std::min(box[k].hi, iv.upper.value));
-  }
-  return box;
 }
 
 dss::HwData ReadData(const BoundsCliOptions& o) {
@@ -334,7 +322,7 @@ void AddBoundsCommand(CLI::App& app) {
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
       const auto outer = dss::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
-      if (o->set == "exact") exact::ComputeExactBounds(MakeExactOptions(*o, options), structure, data, StartBoxFrom(outer, set));
+      if (o->set == "exact") exact::ComputeExactBounds(MakeExactOptions(*o, options), structure, data, exact::StartBoxFromOuter(outer, set));
       return;
     }
     std::vector<double> truth;
@@ -369,32 +357,24 @@ void AddBoundsCommand(CLI::App& app) {
       std::fflush(stdout);
       ProgressDisplay exact_display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
       const auto exact_summary = exact::ComputeExactBounds(
-          MakeExactOptions(*o, options), structure, data, StartBoxFrom(summary, set),
+          MakeExactOptions(*o, options), structure, data, exact::StartBoxFromOuter(summary, set),
           [&exact_display](const exact::ExactBoundsProgress& p) {
             dss::BoundsProgress line;
-            line.phase = fmt::format("exact set: {}{}{}", p.phase, p.detail.empty() ? "" : ": ", p.detail);
-            line.done = line.total = -1;
+            line.phase = "exact set: " + p.phase;
+            line.done = p.done;
+            line.total = p.total;
             line.elapsed_seconds = p.elapsed_seconds;
             exact_display.Show(line);
           });
       exact_display.Finish();
       exact::ExactReportOptions exact_report;
       exact_report.truth = truth;
-      for (const auto& iv : StartBoxFrom(summary, set)) exact_report.outer.emplace_back(iv.lo, iv.hi);
+      for (const auto& iv : exact::StartBoxFromOuter(summary, set)) exact_report.outer.emplace_back(iv.lo, iv.hi);
       exact_report.outer_label = fmt::format("D^ss({})", o->horizon);
       exact_report.stage1_seconds = summary.wall_seconds;
       exact_report.model_class = report.model_class + ", noise bound per sample from the recording or --noise-bound";
       fmt::print("{}", exact::ExactReport(exact_summary, exact_report));
-      nlohmann::json j = exact_summary.to_json();
-      j["set"] = "exact";
-      j["outer_set_intervals"] = result["intervals"];
-      j["outer_set"] = {{"horizon", o->horizon}, {"order", options.order}, {"wall_seconds", summary.wall_seconds}};
-      for (const char* key : {"data", "data_warnings", "structure"}) j[key] = result[key];
-      if (!truth.empty()) {
-        j["truth"] = truth;
-        j["truth_covered"] = exact::TruthInside(exact_summary, truth);
-      }
-      result = j;
+      result = exact::ExactResultJson(exact_summary, result, summary, truth);
       exact_invalidated = exact_summary.invalidated;
     }
     OutputFiles outputs;  // all or none, each renamed into place whole

@@ -6,11 +6,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "python/py_convert.hpp"
+#include "python/py_module.hpp"
+#include "exact/exact_report.hpp"
+#include "exact/two_stage.hpp"
 #include "dss/bounds_report.hpp"
 #include "dss/box_split.hpp"
 #include "dss/set_membership.hpp"
-#include "python/py_convert.hpp"
-#include "python/py_module.hpp"
 #include "sdp/job_executor.hpp"
 #include "sdp/sdp_solver.hpp"
 
@@ -99,6 +101,8 @@ struct BoundsArgs {
   bool order_given = false;  // false: the minimal order of the horizon
   dss::BoundsOptions options;
   dss::AutoSplitOptions auto_split;
+  std::string set = "dss";  // "dss" or "exact" (the exact set D inside the D^ss(n) box)
+  exact::ExactBoundsOptions exact;
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
@@ -153,6 +157,26 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
                     {"proper", !a.structure.strictly_proper},
                     {"input_basis", a.input_basis},
                     {"output_basis", a.output_basis}};
+  if (a.set == "exact" && !summary.invalidated()) {
+    a.exact.executor = a.options.executor;
+    a.exact.run_dir = a.options.run_dir;
+    a.exact.parameters = a.options.parameters;
+    const exact::ExactBoundsSummary exact_summary = WithoutGil([&] {
+      return exact::ComputeExactBounds(a.exact, a.structure, data, exact::StartBoxFromOuter(summary, set));
+    });
+    nlohmann::json e = exact::ExactResultJson(exact_summary, j, summary, {});
+    if (report) {
+      exact::ExactReportOptions r;
+      for (const auto& iv : exact::StartBoxFromOuter(summary, set)) r.outer.emplace_back(iv.lo, iv.hi);
+      r.outer_label = fmt::format("D^ss({})", a.horizon);
+      r.stage1_seconds = summary.wall_seconds;
+      r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}", a.structure.na, a.structure.nb,
+                                  a.input_basis, a.output_basis);
+      e["full_report"] = exact::ExactReport(exact_summary, r);
+    }
+    return ToPython(e);
+  }
+  j["set"] = "dss";
   if (report) {  // the text the CLI prints after a run
     dss::BoundsReportOptions r;
     r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", a.structure.na,
@@ -179,8 +203,14 @@ void DefineBounds(py::module_& m) {
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
          int row_block_order, int stopped_short_refinements, int endpoint_refinements, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
-         py::object progress, std::string source, bool report) {
+         py::object progress, std::string source, bool report, std::string set, int lp_budget, int sweeps) {
         BoundsArgs a;
+        if (set != "dss" && set != "exact")
+          throw py::value_error(fmt::format("set '{}' unknown; expected 'dss' or 'exact'", set));
+        a.set = set;
+        a.exact.search.lp_budget = lp_budget;
+        a.exact.sweeps = sweeps;
+        if (std::string error; !a.exact.IsValid(&error)) throw py::value_error(error);
         a.structure.na = na;
         a.structure.nb = nb;
         a.structure.strictly_proper = strictly_proper;
@@ -231,6 +261,9 @@ progress: called as progress(dict(phase, done, total, from_cache, elapsed_second
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
 its worker processes; with run_dir a rerun resumes from the finished jobs.
+set: "dss" (the default: D^ss(n)) or "exact": the exact set D bounded inside the D^ss(n) box (CLI --set exact;
+docs/exact_set.md); lp_budget and sweeps are the CLI's --lp-budget and --sweeps. With "exact" the dict has
+"set": "exact", intervals of D (with the inner hull), "outer_set_intervals", "stage2" counts and "assumption".
 report: also return the text `hwbounds bounds` prints, as "brief_report" (the interval table and warnings, or the
 verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the bounds came from).)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
@@ -251,7 +284,8 @@ verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the 
       py::arg("endpoint_refinements") = o.endpoint_refinements, py::arg("max_rounds") = g.max_rounds,
       py::arg("add_per_round") = g.add_per_round, py::arg("violation_tolerance") = g.violation_tolerance,
       py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data",
-      py::arg("report") = false);
+      py::arg("report") = false, py::arg("set") = "dss",
+      py::arg("lp_budget") = exact::ObjectiveSearchOptions{}.lp_budget, py::arg("sweeps") = exact::ExactBoundsOptions{}.sweeps);
 }
 
 }  // namespace hw::python
