@@ -32,8 +32,8 @@ std::string RowsKept(const hw::dss::BoundsSummary& s) {
 
 void PrintIntervals(const hw::dss::BoundsSummary& s) {
   for (const auto& iv : s.intervals)
-    fmt::print("         {:<7} [{:.6f}, {:.6f}] {} / {}\n", iv.name, iv.lower.value, iv.upper.value, iv.lower.status,
-               iv.upper.status);
+    fmt::print("         {:<7} [{:.6f}, {:.6f}] {} / {}\n", iv.name, iv.lower.value, iv.upper.value,
+               ToString(iv.lower.status), ToString(iv.upper.status));
 }
 }  // namespace
 

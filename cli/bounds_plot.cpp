@@ -12,7 +12,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/output_files.hpp"
 
 namespace hw::cli {

@@ -145,18 +145,18 @@ dss::HwStructure ReadStructure(const BoundsCliOptions& o) {
 
 // The option values the library checks (the Python module's checks, with the same messages), before any work.
 void CheckBoundsOptions(const BoundsCliOptions& o) {
-  RequireOption("--horizon", [&](std::string* e) { return dss::ValidHorizon(o.horizon, e); });
-  if (o.order_given) RequireOption("--order", [&](std::string* e) { return dss::ValidOrder(o.order, o.horizon, e); });
-  RequireOption("--solver", [&](std::string* e) { return dss::ValidBoundsSolver(o.solver, e); });
-  RequireOption("--threads", [&](std::string* e) { return dss::ValidThreads(o.threads, e); });
-  RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
-  RequireOption("--contract-passes", [&](std::string* e) { return dss::ValidContractionPasses(o.contraction_passes, e); });
-  RequireOption("--row-block-order", [&](std::string* e) { return pop::ValidBlockOrderCap(o.row_block_order, e); });
-  RequireOption("--stopped-short-refinements",
-                [&](std::string* e) { return dss::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
-  RequireOption("--endpoint-refinements",
-                [&](std::string* e) { return dss::ValidEndpointRefinements(o.endpoint_refinements, e); });
-  RequireOption("--auto-split", [&](std::string* e) { return dss::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
+  dss::BoundsSettings settings;
+  settings.horizon = o.horizon;
+  if (o.order_given) settings.order = o.order;
+  settings.solver = o.solver;
+  settings.threads = o.threads;
+  settings.executor = o.executor;
+  settings.contraction_passes = o.contraction_passes;
+  settings.row_block_order = o.row_block_order;
+  settings.stopped_short_refinements = o.stopped_short_refinements;
+  settings.endpoint_refinements = o.endpoint_refinements;
+  settings.auto_split_rounds = o.auto_split;
+  for (const auto& check : dss::SettingChecks(settings)) RequireOption(check.cli_option, check.valid);
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".

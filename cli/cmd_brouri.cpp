@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "core/atomic_write.hpp"
 #include "core/csv_table.hpp"
 #include "core/json_input.hpp"
 #include "core/output_files.hpp"

@@ -4,7 +4,7 @@
 
 #include "cli/commands.hpp"
 #include "compare/study.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/output_files.hpp"
 
 namespace hw::cli {

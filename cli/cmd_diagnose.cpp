@@ -4,7 +4,7 @@
 #include <fmt/format.h>
 
 #include "cli/commands.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/output_files.hpp"
 #include "diagnose/diagnose.hpp"
 

@@ -7,9 +7,10 @@
 #include <fmt/format.h>
 
 #include "cli/commands.hpp"
+#include "core/atomic_write.hpp"
 #include "core/csv_table.hpp"
-#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
+#include "core/output_files.hpp"
 #include "core/recording.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 

@@ -3,7 +3,6 @@
 #include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
-#include "core/csv_table.hpp"
 #include "core/output_files.hpp"
 #include "pop/pop_json.hpp"
 #include "pop/relaxation_size.hpp"

@@ -6,7 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 
 namespace hw::cli {
 

@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 
 #include "cli/commands.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"hwbounds: set-membership bounds, estimators and diagnosis for Hammerstein-Wiener systems"};

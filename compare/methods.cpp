@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "dss/set_membership.hpp"
 #include "estimators/brouri/workflow.hpp"
 #include "estimators/esmaeilani/estimator.hpp"

@@ -7,7 +7,7 @@
 
 #include "compare/methods.hpp"
 #include "compare/study.hpp"
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
 #include "core/output_files.hpp"
 
 namespace hw::compare {

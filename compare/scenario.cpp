@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/json_input.hpp"
 #include "dss/basis.hpp"
 #include "dss/set_membership.hpp"

@@ -1,25 +1,19 @@
 #include "compare/study.hpp"
 
-#include <sys/mman.h>
-#include <sys/types.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <new>
 #include <thread>
 
 #include <fmt/format.h>
 
 #include "compare/methods.hpp"
-#include "core/csv_table.hpp"
-#include "core/worker_process.hpp"
+#include "core/atomic_write.hpp"
+#include "core/input_error.hpp"
+#include "sdp/job_executor.hpp"
 
 namespace hw::compare {
 namespace {
@@ -196,50 +190,33 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   if (!options.quiet)
     fmt::print(stderr, "compare: scenario {}, {} runs ({} to compute, {} resumed), {} worker processes\n",
                scenario.name, options.runs, pending.size(), result.runs_resumed, jobs);
-  std::vector<pid_t> children;
   if (!pending.empty()) {
-    // Runs go to whichever worker is free (a counter in memory the forked workers share): run times differ by
-    // 4x, and a fixed split left one worker with most of the slow runs. A run's result depends only on its
-    // index, never on the worker.
-    void* shared = mmap(nullptr, sizeof(std::atomic<int>), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-    if (shared == MAP_FAILED) throw std::runtime_error("compare: mmap of the shared run counter failed");
-    auto* next_run = new (shared) std::atomic<int>(0);
-    std::fflush(nullptr);
-    const pid_t parent = getpid();
-    for (int w = 0; w < jobs; ++w) {
-      const pid_t pid = fork();
-      if (pid < 0) throw std::runtime_error("compare: fork failed");
-      if (pid == 0) {
-        EndWithParent(parent);
-        int code = 0;
-        for (std::size_t i = next_run->fetch_add(1); i < pending.size(); i = next_run->fetch_add(1)) {
-          const int r = pending[i];
-          try {
-            auto j = RunOne(scenario, options.methods, r, options.seed);
-            j["study_key"] = key;
-            write_text_atomic(RunPath(options.out_dir, r), j.dump(1) + "\n");
-            if (!options.quiet) {
-              std::string line = fmt::format("  run {:3d}:", r);
-              for (const auto& [name, m] : j["methods"].items())
-                if (m.value("applicable", false))
-                  line += fmt::format(" {} {} {:.1f} s;", name, m.value("status", "?"), m.value("seconds", 0.0));
-              fmt::print(stderr, "{}\n", line);
-            }
-          } catch (const std::exception& e) {
-            fmt::print(stderr, "  run {}: {}\n", r, e.what());
-            code = 3;
-          }
-        }
-        std::fflush(nullptr);
-        _exit(code);
+    // One forked process per run, each to whichever worker slot is free (sdp::ForkExecutor): run times differ by
+    // 4x, and a fixed split left one worker with most of the slow runs. A run's result depends only on its index,
+    // never on the worker; the parent writes each result file as it arrives.
+    std::vector<std::string> specs;
+    for (int r : pending) specs.push_back(std::to_string(r));
+    const sdp::JobFunction run = [&](const std::string& spec) {
+      json j = RunOne(scenario, options.methods, std::stoi(spec), options.seed);
+      j["study_key"] = key;
+      return j.dump();
+    };
+    sdp::ForkExecutor executor(jobs);
+    executor.Map(specs, run, [&](std::size_t i, const sdp::JobResult& answer) {
+      const int r = pending[i];
+      if (!answer.ok) {  // reported here; the missing result file is reported below
+        fmt::print(stderr, "  run {}: {}\n", r, answer.error);
+        return;
       }
-      children.push_back(pid);
-    }
-    for (pid_t pid : children) {
-      int status = 0;
-      waitpid(pid, &status, 0);
-    }
-    munmap(shared, sizeof(std::atomic<int>));
+      const json j = json::parse(answer.text);
+      write_text_atomic(RunPath(options.out_dir, r), j.dump(1) + "\n");
+      if (options.quiet) return;
+      std::string line = fmt::format("  run {:3d}:", r);
+      for (const auto& [name, m] : j["methods"].items())
+        if (m.value("applicable", false))
+          line += fmt::format(" {} {} {:.1f} s;", name, m.value("status", "?"), m.value("seconds", 0.0));
+      fmt::print(stderr, "{}\n", line);
+    });
   }
   // Aggregate from the files only.
   std::vector<json> runs;

@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "core/atomic_write.hpp"
+
 namespace hw {
 namespace {
 
@@ -125,24 +127,6 @@ std::string read_text_file(const std::string& path, const std::string& what) {
 
 CsvTable read_csv(const std::string& path, bool allow_nonfinite) {
   return parse_csv(read_text_file(path, "CSV file"), path, allow_nonfinite);
-}
-
-void write_text_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::error_code ec;
-  try {
-    {
-      std::ofstream out(tmp, std::ios::binary);
-      if (!out) throw std::runtime_error(fmt::format("{}: cannot write ({})", tmp, std::strerror(errno)));
-      out << text;
-      out.flush();
-      if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
-    }
-    std::filesystem::rename(tmp, path);
-  } catch (const std::exception& e) {
-    std::filesystem::remove(tmp, ec);  // never leave a half-written file behind
-    throw std::runtime_error(fmt::format("{}: not written: {}", path, e.what()));
-  }
 }
 
 std::string format_csv(const CsvTable& table, int precision) {

@@ -2,16 +2,12 @@
 // Numeric CSV tables with a header row: the project's recording format.
 // Errors name the file, the line, what is wrong and what would be right.
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace hw {
+#include "core/input_error.hpp"
 
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace hw {
 
 struct CsvTable {
   std::string source;                      // file name, for messages
@@ -35,9 +31,8 @@ CsvTable parse_csv(const std::string& text, const std::string& source, bool allo
 // file and what it should be (`what`, e.g. "CSV file").
 std::string read_text_file(const std::string& path, const std::string& what = "file");
 
-// Writes atomically: to path + ".tmp", then rename, so a killed run leaves no half-written file.
+// Writes atomically (core/atomic_write.hpp), so a killed run leaves no half-written file.
 void write_csv(const std::string& path, const CsvTable& table, int precision = 12);
 std::string format_csv(const CsvTable& table, int precision = 12);  // the text write_csv writes
-void write_text_atomic(const std::string& path, const std::string& text);
 
 }  // namespace hw

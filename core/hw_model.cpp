@@ -8,7 +8,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
+#include "core/input_error.hpp"
 #include "core/json_input.hpp"
 
 namespace hw {

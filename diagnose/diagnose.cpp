@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "diagnose/locate.hpp"
 
 namespace hw::diagnose {

@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 
 namespace hw::diagnose {
 namespace {

@@ -9,7 +9,6 @@
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
 #include "diagnose/signal_stats.hpp"
 
 namespace hw::diagnose {

@@ -6,7 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
+#include "core/input_error.hpp"
 #include "core/output_files.hpp"
 #include "diagnose/diagnose.hpp"
 

@@ -19,10 +19,8 @@ struct AggregateOptions {
 
 struct AggregateResult {
   std::vector<ParameterInterval> intervals;
-  // Where the orthant bounds entering the endpoints came from: "final round", "earlier round",
-  // "unfinished solve" (a verified last iterate), "cheap order", "box edge", "stopped beyond a feasible point's
-  // value" (a job that ended once its bound passed a certified feasible point's: it cannot attain the endpoint).
-  std::map<std::string, int> sources;
+  // Where the orthant bounds entering the endpoints came from (dss/statuses.hpp).
+  std::map<BoundSource, int> sources;
   bool clipped_to_box = false;  // some endpoint was intersected with the prior box
 };
 

@@ -10,11 +10,8 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
-#include "dss/inner_points.hpp"
-#include "dss/row_reduction.hpp"
+#include "core/atomic_write.hpp"
 #include "pop/constraint_generation.hpp"
-#include "pop/moment_lp.hpp"
 
 namespace hw::dss {
 namespace fs = std::filesystem;
@@ -30,6 +27,16 @@ double now_seconds() {
 }
 
 std::string other_solver(const std::string& s) { return s == "csdp" ? "sdpa" : "csdp"; }
+
+// A constraint-generation round's origin as a job's.
+JobOrigin OriginOf(pop::BoundOrigin origin) {
+  switch (origin) {
+    case pop::BoundOrigin::kNone: return JobOrigin::kNone;
+    case pop::BoundOrigin::kFinalRound: return JobOrigin::kFinalRound;
+    case pop::BoundOrigin::kEarlierRound: return JobOrigin::kEarlierRound;
+  }
+  return JobOrigin::kNone;
+}
 
 // The run directory's record of the jobs dispatched so far (RunCache::plan).
 constexpr const char* kPlanFile = "planned.json";
@@ -50,17 +57,17 @@ std::optional<std::set<std::string>> ReadPlannedJobs(const fs::path& file) {
 }  // namespace
 
 nlohmann::json JobOutcome::to_json() const {
-  return {{"status", status}, {"bound", bound}, {"tight", tight}, {"message", message}, {"rounds", rounds},
+  return {{"status", ToString(status)}, {"bound", bound}, {"tight", tight}, {"message", message}, {"rounds", rounds},
           {"sdp_iterations", sdp_iterations}, {"seconds", seconds}, {"moments", moments}, {"blocks", blocks},
-          {"working_set", working_set}, {"active_set", active_set}, {"verification", verification}, {"float_bound", float_bound},
-          {"correction", correction}, {"verify_seconds", verify_seconds}, {"origin", origin},
+          {"working_set", working_set}, {"active_set", active_set}, {"verification", sdp::ToString(verification)}, {"float_bound", float_bound},
+          {"correction", correction}, {"verify_seconds", verify_seconds}, {"origin", ToString(origin)},
           {"bound_round", bound_round}, {"unfinished", unfinished},
           {"beyond_known_value", beyond_known_value}, {"first_moments", first_moments}};
 }
 
 JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
   JobOutcome o;
-  o.status = j.at("status");
+  o.status = JobStatusFromString(j.at("status"));
   o.bound = j.at("bound");
   o.tight = j.at("tight");
   o.message = j.at("message");
@@ -71,11 +78,11 @@ JobOutcome JobOutcome::from_json(const nlohmann::json& j) {
   o.blocks = j.at("blocks");
   o.working_set = j.at("working_set").get<std::vector<int>>();
   if (j.contains("active_set")) o.active_set = j.at("active_set").get<std::vector<int>>();
-  o.verification = j.at("verification");
+  o.verification = VerifyStatusFromString(j.at("verification"));
   o.float_bound = j.at("float_bound");
   o.correction = j.at("correction");
   o.verify_seconds = j.at("verify_seconds");
-  o.origin = j.at("origin");
+  o.origin = JobOriginFromString(j.at("origin"));
   o.bound_round = j.at("bound_round");
   o.unfinished = j.at("unfinished");
   o.beyond_known_value = j.value("beyond_known_value", false);
@@ -176,7 +183,7 @@ void ProgressReporter::Message(const std::string& text) {
   if (sink_) sink_({text, -1, -1, 0, 0.0, 0.0});
 }
 
-std::string BoxHash(const Box& box) { return TextHash(nlohmann::json(box).dump()); }
+std::string BoxHash(const ParameterBox& box) { return TextHash(nlohmann::json(box).dump()); }
 
 std::string TextHash(const std::string& text) { return fmt::format("{:016x}", fnv(1469598103934665603ull, text)); }
 
@@ -190,163 +197,99 @@ pop::PolyProblem OrthantObjectiveCore(const HwOuterSet& set, int l, const Object
   return core;
 }
 
-sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet& prior_set) {
-  // Per-process memo of the outer set in each box and of each orthant's data rows (built once, read-only after).
-  struct Memo {
-    std::mutex mutex;
-    std::map<std::string, std::unique_ptr<HwOuterSet>> sets;
-    std::map<std::pair<std::string, int>, std::vector<DataConstraint>> rows;
-  };
-  auto memo = std::make_shared<Memo>();
-  auto set_for = [memo, &prior_set](const Box& b) -> const HwOuterSet& {
-    if (b == prior_set.box()) return prior_set;
-    std::lock_guard<std::mutex> lock(memo->mutex);
-    auto& slot = memo->sets[BoxHash(b)];
-    if (!slot) slot = std::make_unique<HwOuterSet>(prior_set.WithBox(b));
-    return *slot;
-  };
-  auto rows_for = [memo, set_for](const Box& b, int l) -> const std::vector<DataConstraint>& {
-    const HwOuterSet& s = set_for(b);
-    std::lock_guard<std::mutex> lock(memo->mutex);
-    auto& r = memo->rows[{BoxHash(b), l}];
-    if (r.empty()) r = s.data_constraints(l);
-    return r;
-  };
+JobContext::JobContext(const BoundsOptions& options, const HwOuterSet& prior_set)
+    : options_(options), prior_set_(prior_set) {}
 
-  return [&options, &prior_set, set_for, rows_for](const std::string& text) -> std::string {
-    const auto spec = nlohmann::json::parse(text);
-    const int l = spec.at("l");
-    const std::string kind = spec.at("kind");
-    const int n = prior_set.num_vars();
-    const auto& gen_options = options.generation;
-    if (kind == "lp") {
-      std::vector<Polynomial> cons = prior_set.sign_constraints(l);
-      for (const auto& d : rows_for(prior_set.box(), l)) cons.push_back(d.g);
-      // An LP: DSDP's LP cone is not used for the screen (its certificates are checked on CSDP's and SDPA's form).
-      const std::string backend = SolverForOrder(options.solver, 1);
-      auto solver = sdp::MakeSolver(backend == "dsdp" ? "csdp" : backend);
-      sdp::SdpOptions lp_options = gen_options.sdp;
-      lp_options.keep_dual_matrix = false;
-      sdp::VerifiedBound cert;
-      const auto s = pop::ScreenWithLinearProgram(cons, n, lp_options, *solver, gen_options.verify.enabled ? &cert : nullptr);
-      return nlohmann::json{{"empty", s.status == sdp::SdpStatus::kInfeasible}, {"status", sdp::ToString(s.status)},
-                            {"verification", sdp::ToString(cert.status)}}
-          .dump();
-    }
-    if (kind == "witness") {
-      // Local extreme of one objective from the given starts in turn, until a start gives a feasible point.
-      const std::vector<int> rows = spec.at("rows").get<std::vector<int>>();
-      const int param = spec.at("param"), dir = spec.at("dir");
-      nlohmann::json answer{{"found", false}, {"solves", 0}};
-      for (const auto& start : spec.at("starts")) {
-        const auto w = LocalExtreme(prior_set, l, param, dir, start.get<std::vector<double>>(), options.edge_witness.local,
-                                    &rows);
-        answer["solves"] = answer["solves"].get<int>() + 1;
-        if (w.found) {
-          answer["found"] = true;
-          answer["point"] = w.point;
-          break;
-        }
-      }
-      return answer.dump();
-    }
-    const Box box = spec.at("box").get<Box>();
-    const HwOuterSet& set = set_for(box);
-    const auto& all_rows = rows_for(box, l);
-    if (kind == "reduce") {
-      // Rows never combine across horizon steps, so each step may be a job of its own ("step"; 0 = all).
-      const int only_step = spec.value("step", 0);
-      std::vector<Polynomial> rows;
-      std::vector<int> steps, index;
-      for (std::size_t i = 0; i < all_rows.size(); ++i) {
-        if (only_step != 0 && all_rows[i].s != only_step) continue;
-        rows.push_back(all_rows[i].g);
-        steps.push_back(all_rows[i].s);
-        index.push_back(static_cast<int>(i));
-      }
-      std::vector<Polynomial> fixed = set.box_constraints();
-      for (auto& g : set.sign_constraints(l)) fixed.push_back(std::move(g));
-      const auto r = ReduceDataRows(options.reduction, rows, steps, fixed);
-      std::vector<int> kept;  // indices into all_rows
-      for (int k : r.kept) kept.push_back(index[k]);
-      nlohmann::json counts = nlohmann::json::array();
-      for (const auto& c : r.per_step)
-        counts.push_back(
-            {{"step", c.step}, {"rows", c.rows}, {"kept", c.kept}, {"iteration_limited", c.iteration_limited}});
-      return nlohmann::json{{"kept", kept}, {"per_step", counts}, {"linear_programs", r.linear_programs},
-                            {"seconds", r.seconds}}
-          .dump();
-    }
-    // kind == "relax"
-    const Objective obj{spec.at("param").get<int>(), spec.at("dir").get<int>()};
-    const pop::PolyProblem core = OrthantObjectiveCore(set, l, obj);
-    std::vector<Polynomial> candidates;
-    for (int i : spec.at("rows").get<std::vector<int>>()) candidates.push_back(all_rows.at(i).g);
-    pop::ConstraintGenerationOptions gen = gen_options;
-    gen.order = spec.at("d");
-    if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
-    if (spec.contains("stop_beyond")) {  // original units -> this box's scaled units
-      const auto& scaling = set.scaling();
-      gen.stop_beyond = (spec.at("stop_beyond").get<double>() - scaling.center[obj.param]) / scaling.radius[obj.param];
-    }
-    const std::string backend = SolverForOrder(options.solver, gen.order, gen.block_order_cap);
-    auto solver = sdp::MakeSolver(backend);
-    auto other = sdp::MakeSolver(other_solver(backend));
-    const std::string label = fmt::format("orthant {} {} {} order {}", l, obj.dir < 0 ? "min" : "max",
-                                          set.layout().names[obj.param], gen.order);
-    auto on_round = [&](const pop::GenerationRound& r) {
-      if (!options.round_log) return;
-      const std::string bound =
-          std::isnan(r.bound) ? "none yet"
-                              : fmt::format("{} {:.6g}{}", obj.dir < 0 ? ">=" : "<=",
-                                            set.scaling().to_original(obj.param, r.bound),
-                                            r.bound_verified ? " (verified)" : "");
-      options.round_log(fmt::format("[{}] round {}: {} blocks{} + {} linear rows, {} ({:.1f} s), {} violated, bound {}",
-                                    label, r.round, r.blocks,
-                                    r.active < 0 ? std::string() : fmt::format(" ({} active)", r.active),
-                                    r.linear_rows, r.status, r.seconds,
-                                    r.violated < 0 ? std::string("-") : std::to_string(r.violated), bound));
-    };
-    const auto r = pop::SolveWithConstraintGeneration(gen, core, candidates, spec.at("initial").get<std::vector<int>>(),
-                                                 *solver, on_round, other.get());
-    JobOutcome out;
-    out.rounds = r.rounds;
-    out.sdp_iterations = r.sdp_iterations;
-    out.seconds = r.solve_seconds;
-    out.moments = r.num_moments;
-    out.blocks = r.num_blocks;
-    out.working_set = r.working_set;
-    out.active_set = r.active_set;
-    out.message = r.message;
-    out.tight = r.tight;
-    out.beyond_known_value = r.beyond_known_value;
-    out.verification = sdp::ToString(r.verification.status);
-    out.verify_seconds = r.verification.seconds;
-    out.origin = ToString(r.origin);
-    out.bound_round = r.bound_round;
-    out.unfinished = r.bound_from_unfinished_solve;
-    for (std::size_t i = 0; i < r.first_moments.size(); ++i)
-      out.first_moments.push_back(set.scaling().to_original(static_cast<int>(i), r.first_moments[i]));
-    if (r.status == pop::RelaxationStatus::kInfeasible) {
-      out.status = "infeasible";
-    } else if (r.status == pop::RelaxationStatus::kSolved) {
-      out.status = "solved";
-      out.float_bound = set.scaling().to_original(obj.param, r.float_bound);
-      // Every parameter lies in the job's box (scaled [-1, 1]), so a bound weaker than its edge (the verified
-      // bound of an unfinished iterate can be) is replaced by the edge: still valid.
-      const double scaled = obj.dir < 0 ? std::max(r.bound, -1.0) : std::min(r.bound, 1.0);
-      out.bound = set.scaling().to_original(obj.param, scaled);
-      if (r.verification.verified()) {
-        // The affine map back to original units rounds twice: widen outward by a few ulps of its terms.
-        const auto [lo, hi] = set.box()[obj.param];
-        out.bound += obj.dir * 4 * std::numeric_limits<double>::epsilon() * (std::max(std::abs(lo), std::abs(hi)) + (hi - lo));
-        out.correction = std::abs(out.bound - out.float_bound);
-      }
-    } else {
-      out.status = "failed";
-    }
-    return out.to_json().dump();
+const HwOuterSet& JobContext::set_in(const ParameterBox& box) const {
+  if (box == prior_set_.box()) return prior_set_;
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& slot = sets_[BoxHash(box)];
+  if (!slot) slot = std::make_unique<HwOuterSet>(prior_set_.WithBox(box));
+  return *slot;
+}
+
+const std::vector<DataConstraint>& JobContext::rows_in(const ParameterBox& box, int l) const {
+  const HwOuterSet& s = set_in(box);
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& r = rows_[{BoxHash(box), l}];
+  if (r.empty()) r = s.data_constraints(l);
+  return r;
+}
+
+nlohmann::json AnswerRelaxJob(const JobContext& job, const nlohmann::json& spec) {
+  const BoundsOptions& options = job.options();
+  const int l = spec.at("l");
+  const ParameterBox box = spec.at("box").get<ParameterBox>();
+  const HwOuterSet& set = job.set_in(box);
+  const auto& all_rows = job.rows_in(box, l);
+  const Objective obj{spec.at("param").get<int>(), spec.at("dir").get<int>()};
+  const pop::PolyProblem core = OrthantObjectiveCore(set, l, obj);
+  std::vector<Polynomial> candidates;
+  for (int i : spec.at("rows").get<std::vector<int>>()) candidates.push_back(all_rows.at(i).g);
+  pop::ConstraintGenerationOptions gen = options.generation;
+  gen.order = spec.at("d");
+  if (spec.contains("max_rounds")) gen.max_rounds = spec.at("max_rounds");
+  if (spec.contains("stop_beyond")) {  // original units -> this box's scaled units
+    const auto& scaling = set.scaling();
+    gen.stop_beyond = (spec.at("stop_beyond").get<double>() - scaling.center[obj.param]) / scaling.radius[obj.param];
+  }
+  const std::string backend = SolverForOrder(options.solver, gen.order, gen.block_order_cap);
+  auto solver = sdp::MakeSolver(backend);
+  auto other = sdp::MakeSolver(other_solver(backend));
+  const std::string label = fmt::format("orthant {} {} {} order {}", l, obj.dir < 0 ? "min" : "max",
+                                        set.layout().names[obj.param], gen.order);
+  auto on_round = [&](const pop::GenerationRound& r) {
+    if (!options.round_log) return;
+    const std::string bound =
+        std::isnan(r.bound) ? "none yet"
+                            : fmt::format("{} {:.6g}{}", obj.dir < 0 ? ">=" : "<=",
+                                          set.scaling().to_original(obj.param, r.bound),
+                                          r.bound_verified ? " (verified)" : "");
+    options.round_log(fmt::format("[{}] round {}: {} blocks{} + {} linear rows, {} ({:.1f} s), {} violated, bound {}",
+                                  label, r.round, r.blocks,
+                                  r.active < 0 ? std::string() : fmt::format(" ({} active)", r.active),
+                                  r.linear_rows, r.status, r.seconds,
+                                  r.violated < 0 ? std::string("-") : std::to_string(r.violated), bound));
   };
+  const auto r = pop::SolveWithConstraintGeneration(gen, core, candidates, spec.at("initial").get<std::vector<int>>(),
+                                                    *solver, on_round, other.get());
+  JobOutcome out;
+  out.rounds = r.rounds;
+  out.sdp_iterations = r.sdp_iterations;
+  out.seconds = r.solve_seconds;
+  out.moments = r.num_moments;
+  out.blocks = r.num_blocks;
+  out.working_set = r.working_set;
+  out.active_set = r.active_set;
+  out.message = r.message;
+  out.tight = r.tight;
+  out.beyond_known_value = r.beyond_known_value;
+  out.verification = r.verification.status;
+  out.verify_seconds = r.verification.seconds;
+  out.origin = OriginOf(r.origin);
+  out.bound_round = r.bound_round;
+  out.unfinished = r.bound_from_unfinished_solve;
+  for (std::size_t i = 0; i < r.first_moments.size(); ++i)
+    out.first_moments.push_back(set.scaling().to_original(static_cast<int>(i), r.first_moments[i]));
+  if (r.status == pop::RelaxationStatus::kInfeasible) {
+    out.status = JobStatus::kInfeasible;
+  } else if (r.status == pop::RelaxationStatus::kSolved) {
+    out.status = JobStatus::kSolved;
+    out.float_bound = set.scaling().to_original(obj.param, r.float_bound);
+    // Every parameter lies in the job's box (scaled [-1, 1]), so a bound weaker than its edge (the verified
+    // bound of an unfinished iterate can be) is replaced by the edge: still valid.
+    const double scaled = obj.dir < 0 ? std::max(r.bound, -1.0) : std::min(r.bound, 1.0);
+    out.bound = set.scaling().to_original(obj.param, scaled);
+    if (r.verification.verified()) {
+      // The affine map back to original units rounds twice: widen outward by a few ulps of its terms.
+      const auto [lo, hi] = set.box()[obj.param];
+      out.bound += obj.dir * 4 * std::numeric_limits<double>::epsilon() * (std::max(std::abs(lo), std::abs(hi)) + (hi - lo));
+      out.correction = std::abs(out.bound - out.float_bound);
+    }
+  } else {
+    out.status = JobStatus::kFailed;
+  }
+  return out.to_json();
 }
 
 void DispatchJobs(EngineContext& ctx, const std::vector<std::pair<std::string, std::string>>& jobs,
@@ -395,13 +338,13 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
     const RelaxJob& job = jobs[i];
     const OrthantWork& o = *job.orthant;
     if (o.empty()) {  // proven empty by an earlier job of this stage
-      outs[i].status = "infeasible";
-      outs[i].message = "orthant already proven empty (" + o.status + ")";
+      outs[i].status = JobStatus::kInfeasible;
+      outs[i].message = "orthant already proven empty (" + o.certificate->status() + ")";
       ctx.progress.Done();
       continue;
     }
     // Data rows enter the spec as orthant row indices; the initial blocks as positions among them.
-    nlohmann::json spec{{"kind", "relax"}, {"l", o.index}, {"param", job.objective.param}, {"dir", job.objective.dir},
+    nlohmann::json spec{{"kind", kRelaxJob}, {"l", o.index}, {"param", job.objective.param}, {"dir", job.objective.dir},
                         {"d", job.order}, {"box", o.box}, {"rows", o.rows}, {"initial", job.initial}};
     std::string key = fmt::format("o{}_l{}_{}_{}", job.order, o.index, ctx.set.layout().names[job.objective.param],
                                   job.objective.dir < 0 ? "min" : "max");
@@ -421,7 +364,7 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
     const std::size_t i = spec_job[s];
     JobOutcome& out = outs[i];
     if (answer.contains("job_error")) {
-      out.status = "failed";
+      out.status = JobStatus::kFailed;
       out.message = "job failed: " + answer.at("job_error").get<std::string>();
     } else {
       out = JobOutcome::from_json(answer);
@@ -436,10 +379,11 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
     }
     ctx.counters.largest_moments = std::max(ctx.counters.largest_moments, out.moments);
     ctx.counters.largest_blocks = std::max(ctx.counters.largest_blocks, out.blocks);
-    if (out.status == "infeasible") {
+    if (out.status == JobStatus::kInfeasible) {
       OrthantWork& o = orthants.at(static_cast<std::size_t>(&*jobs[i].orthant - orthants.data()));
       if (!o.empty())
-        o.ProveEmpty({"relaxation", jobs[i].order, o.box != ctx.set.box(), out.verification == "verified"});
+        o.ProveEmpty({CertificateKind::kRelaxation, jobs[i].order, o.box != ctx.set.box(),
+                      out.verification == sdp::VerifyStatus::kVerified});
     }
     ctx.progress.Done();
   });

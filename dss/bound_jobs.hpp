@@ -1,8 +1,9 @@
 #pragma once
-// The jobs of the bound engine, as text, so that one job function answers them in this process, in forked
-// workers or on other MPI ranks (sdp/job_executor.hpp). A job depends only on (options, set) and its spec, never
+// The jobs of the bound engine, as text, so that one job function (dss/job_function.hpp) answers them in this
+// process, in forked workers or on other MPI ranks (sdp/job_executor.hpp). A job depends only on (options, set) and its spec, never
 // on which worker runs it or when, so results do not depend on timing:
-//   {"kind": "lp", "l"}                          LP screen of orthant l (emptiness, verified);
+//   {"kind": "lp", "l"}                          LP screen of orthant l (emptiness, verified;
+//                                                dss/orthant_screen.hpp);
 //   {"kind": "reduce", "l", "box", ["step"]}     exact row reduction of orthant l's data rows of horizon step
 //                                                `step` (all steps without it; dss/row_reduction.hpp);
 //   {"kind": "witness", "l", "param", "dir", "starts", "rows"}
@@ -18,6 +19,8 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -25,14 +28,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dss/bounds_options.hpp"
+#include "dss/bounds_summary.hpp"
 #include "dss/hw_outer_set.hpp"
-#include "dss/set_membership.hpp"
 #include "pop/moment_relaxation.hpp"
 #include "sdp/job_executor.hpp"
 
 namespace hw::dss {
-
-using Box = std::vector<std::pair<double, double>>;
 
 // One objective: min (dir = -1) or max (dir = +1) of parameter `param`.
 struct Objective {
@@ -42,7 +44,7 @@ struct Objective {
 
 // A relaxation job's answer (bounds in original units).
 struct JobOutcome {
-  std::string status;  // "solved", "infeasible", "failed"
+  JobStatus status = JobStatus::kFailed;
   double bound = 0.0;
   bool tight = false;
   std::string message;
@@ -52,10 +54,10 @@ struct JobOutcome {
   std::size_t moments = 0, blocks = 0;
   std::vector<int> working_set;  // indices into the job's rows that had blocks in the last LMI
   std::vector<int> active_set;   // the part of it with non-negligible multipliers (warm start of other jobs)
-  // "off", "verified", "unverified"; bound is the verified value when verified, float_bound the solver's.
-  std::string verification = "off";
+  // bound is the verified value when verified, float_bound the solver's.
+  sdp::VerifyStatus verification = sdp::VerifyStatus::kNotRun;
   double float_bound = 0.0, correction = 0.0, verify_seconds = 0.0;
-  std::string origin = "none";     // BoundOrigin: "final round" or "earlier round"
+  JobOrigin origin = JobOrigin::kNone;
   int bound_round = 0;
   bool unfinished = false;         // the bound is the verified last iterate of a solve that stopped short
   bool beyond_known_value = false; // ended once its bound passed stop_beyond: valid, cannot move the endpoint
@@ -136,9 +138,33 @@ struct EngineContext {
 // and the sign constraints of orthant l (the data rows are the candidates of constraint generation).
 pop::PolyProblem OrthantObjectiveCore(const HwOuterSet& set, int l, const Objective& objective);
 
-// Builds the job function for (options, set): the outer set in every box a job names and each orthant's data
-// rows are built on first use and kept (before a fork, workers inherit them).
-sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet& set);
+// What a job's handler works with in the process that runs it: the run's options, the prior outer set, and the
+// outer set and each orthant's data rows in any box a job names, built on first use and kept (before a fork,
+// workers inherit them).
+class JobContext {
+ public:
+  JobContext(const BoundsOptions& options, const HwOuterSet& prior_set);
+  const BoundsOptions& options() const { return options_; }
+  const HwOuterSet& prior_set() const { return prior_set_; }
+  const HwOuterSet& set_in(const ParameterBox& box) const;
+  const std::vector<DataConstraint>& rows_in(const ParameterBox& box, int l) const;
+
+ private:
+  const BoundsOptions options_;  // a copy: a job function may outlive the caller's options
+  const HwOuterSet& prior_set_;
+  mutable std::mutex mutex_;
+  mutable std::map<std::string, std::unique_ptr<HwOuterSet>> sets_;
+  mutable std::map<std::pair<std::string, int>, std::vector<DataConstraint>> rows_;
+};
+
+// The API every job kind implements: the answer (JSON) to one spec of its kind. Each stage's file owns its kind
+// and handler (kScreenJob in dss/orthant_screen.hpp, ...); dss/job_function.hpp registers them.
+using JobHandler = nlohmann::json (*)(const JobContext& job, const nlohmann::json& spec);
+
+// The relaxation job kind (every pass runs it):
+// {"kind": "relax", "l", "param", "dir", "d", "box", "rows", "initial", ["max_rounds"], ["stop_beyond"]} -> JobOutcome.
+inline constexpr char kRelaxJob[] = "relax";
+nlohmann::json AnswerRelaxJob(const JobContext& job, const nlohmann::json& spec);
 
 // Runs jobs (spec, cache key) through the cache and the executor; `on_done(i, answer, cached)` sees every
 // answer (cached ones first). A failed job (crash, exception) answers {"job_error": why} and is not cached.
@@ -148,16 +174,12 @@ void DispatchJobs(EngineContext& ctx, const std::vector<std::pair<std::string, s
 // An orthant that is still alive, with its box and its kept data rows (indices into data_constraints(l)).
 struct OrthantWork {
   int index = 0;
-  Box box;
+  ParameterBox box;
   std::vector<int> rows;
   std::vector<nlohmann::json> reduction;  // per step: {"step", "rows", "kept"} (JSON of RowGroupCount)
-  std::string status = "undecided";       // or "empty (...)": the certificate that proved it empty
-  std::optional<EmptinessCertificate> certificate;  // set with the status by ProveEmpty
-  bool empty() const { return status.rfind("empty", 0) == 0; }
-  void ProveEmpty(const EmptinessCertificate& c) {
-    certificate = c;
-    status = c.status();
-  }
+  std::optional<EmptinessCertificate> certificate;  // the certificate that proved it empty (ProveEmpty)
+  bool empty() const { return certificate.has_value(); }
+  void ProveEmpty(const EmptinessCertificate& c) { certificate = c; }
 };
 
 // One relaxation job: objective over an orthant at an order, with blocks for `initial` (indices into rows).
@@ -173,7 +195,7 @@ struct RelaxJob {
 };
 
 // Runs relaxation jobs (cached ones are read), adds to the counters, reports progress (one step per job), and
-// marks orthants that a job proved empty. Failed jobs come back with status "failed" and the reason.
+// marks orthants that a job proved empty. Failed jobs come back with status kFailed and the reason.
 std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<RelaxJob>& jobs,
                                           std::vector<OrthantWork>& orthants);
 
@@ -181,7 +203,7 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
 std::vector<int> RowsOfWorkingSet(const OrthantWork& orthant, const std::vector<int>& working_set);
 
 // A short hash of a box (cache keys of jobs in contracted boxes).
-std::string BoxHash(const Box& box);
+std::string BoxHash(const ParameterBox& box);
 // A short hash of a text (cache keys of jobs named by their inputs).
 std::string TextHash(const std::string& text);
 

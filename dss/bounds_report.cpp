@@ -18,16 +18,18 @@ void AppendIntervals(std::string& out, const BoundsSummary& summary, const std::
              "verified", "correction lo/up", "feasible points reach", "status");
   for (const auto& iv : summary.intervals) {
     const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
-    std::string status = iv.lower.status == "guaranteed" && iv.upper.status == "guaranteed"
-                             ? "guaranteed"
-                             : fmt::format("lower {}, upper {}", iv.lower.status, iv.upper.status);
+    const bool both_guaranteed =
+        iv.lower.status == EndpointStatus::kGuaranteed && iv.upper.status == EndpointStatus::kGuaranteed;
+    std::string status = both_guaranteed ? ToString(EndpointStatus::kGuaranteed)
+                                         : fmt::format("lower {}, upper {}", ToString(iv.lower.status),
+                                                       ToString(iv.upper.status));
     if (!truth.empty()) {
       const bool in = iv.lower.value <= truth[k] && truth[k] <= iv.upper.value;
       status += fmt::format("  truth {:.6g} {}", truth[k], in ? "inside" : "OUTSIDE");
     }
     const std::string verified = iv.lower.verification == iv.upper.verification
-                                     ? iv.lower.verification
-                                     : iv.lower.verification + "/" + iv.upper.verification;
+                                     ? sdp::ToString(iv.lower.verification)
+                                     : sdp::ToString(iv.lower.verification) + "/" + sdp::ToString(iv.upper.verification);
     // The inner side: certified points of the set reach this range, so the exact interval lies between the two.
     const std::string reached = iv.witnessed_lower && iv.witnessed_upper
                                     ? fmt::format("[{:.6f}, {:.6f}]", *iv.witnessed_lower, *iv.witnessed_upper)
@@ -41,10 +43,13 @@ void AppendIntervals(std::string& out, const BoundsSummary& summary, const std::
 
 // How one orthant was proven empty, for a person: "LP screen, verified in interval arithmetic".
 std::string CertificateText(const EmptinessCertificate& c) {
-  const std::string how = c.kind == "lp"               ? "LP screen infeasible"
-                          : c.kind == "relaxation"     ? fmt::format("order {} relaxation infeasible", c.order)
-                          : c.kind == "pieces"         ? "proven empty in every piece of the split box"
-                                                       : fmt::format("order {} bounds cross", c.order);
+  std::string how;
+  switch (c.kind) {
+    case CertificateKind::kLinearProgram: how = "LP screen infeasible"; break;
+    case CertificateKind::kRelaxation: how = fmt::format("order {} relaxation infeasible", c.order); break;
+    case CertificateKind::kPieces: how = "proven empty in every piece of the split box"; break;
+    case CertificateKind::kCrossedBounds: how = fmt::format("order {} bounds cross", c.order); break;
+  }
   return fmt::format("{}{}, {}", how, c.contracted_box ? " in the contracted box" : "",
                      c.verified ? "verified in interval arithmetic" : "the solver's floating-point certificate (unverified)");
 }
@@ -57,7 +62,7 @@ void AppendInvalidation(std::string& out, const BoundsSummary& summary, const Bo
   std::map<std::string, int> by_certificate;
   int verified = 0;
   for (const auto& r : summary.orthants) {
-    ++by_certificate[r.status];
+    ++by_certificate[r.status_text()];
     verified += r.certificate && r.certificate->verified ? 1 : 0;
   }
   std::string counts;
@@ -65,7 +70,7 @@ void AppendInvalidation(std::string& out, const BoundsSummary& summary, const Bo
   fmt::format_to(std::back_inserter(out), "certificates: all {} sign orthants are proven empty ({}); {} of them verified in interval arithmetic{}:\n",
              summary.orthants_total, counts, verified, o.verify ? "" : " (verification off)");
   for (const auto& r : summary.orthants)
-    fmt::format_to(std::back_inserter(out), "  orthant {:>3} ({}): {}\n", r.index, r.signs, r.certificate ? CertificateText(*r.certificate) : r.status);
+    fmt::format_to(std::back_inserter(out), "  orthant {:>3} ({}): {}\n", r.index, r.signs, r.certificate ? CertificateText(*r.certificate) : r.status_text());
   fmt::format_to(std::back_inserter(out), "next: `hwbounds diagnose --data REC --validate REC2 --fit hw:NA,NB,PIN,POUT` looks for what the model "
              "leaves out (docs/diagnose.md); a larger noise bound, other bases or orders, or a wider --box change the "
              "question.\n");
@@ -189,7 +194,7 @@ void AppendRunSummary(std::string& out, const BoundsSummary& summary, bool verif
   }
   if (!summary.bound_sources.empty()) {
     std::string sources;
-    for (const auto& [what, count] : summary.bound_sources)
+    for (const auto& [what, count] : ByName(summary.bound_sources))
       sources += fmt::format("{}{} {}", sources.empty() ? "" : ", ", count, what);
     fmt::format_to(std::back_inserter(out), "orthant bounds entering the endpoints: {}\n", sources);
   }
@@ -208,7 +213,7 @@ void AppendWarnings(std::string& out, const BoundsSummary& summary, bool verify)
   if (!verify) return;
   for (const auto& iv : summary.intervals)
     for (const auto* ep : {&iv.lower, &iv.upper})
-      if (ep->verification == "unverified") {
+      if (ep->verification == sdp::VerifyStatus::kUnverified) {
         fmt::format_to(std::back_inserter(out), "WARNING: {} has an endpoint that rests on an unverified floating-point bound (see notes).\n",
                    iv.name);
         break;

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "dss/set_membership.hpp"
+#include "dss/bounds_summary.hpp"
 
 namespace hw::dss {
 

@@ -14,14 +14,14 @@ double ContractOrthantBoxes(EngineContext& ctx, const std::vector<Objective>& ob
   double shrink = 0.0;
   for (auto& o : orthants) {
     if (o.empty()) continue;
-    Box next = o.box;
+    ParameterBox next = o.box;
     bool crossed = false;
     for (int k = 0; k < n && !crossed; ++k) {
       const double width = next[k].second - next[k].first;
       for (std::size_t j = 0; j < objectives.size(); ++j) {
         if (objectives[j].param != k) continue;
         const auto& r = pass.at({o.index, static_cast<int>(j)});
-        if (r.status != "solved" || (verify_on && r.verification != "verified")) continue;
+        if (r.status != JobStatus::kSolved || (verify_on && r.verification != sdp::VerifyStatus::kVerified)) continue;
         if (objectives[j].dir < 0) next[k].first = std::max(next[k].first, r.bound);
         else next[k].second = std::min(next[k].second, r.bound);
       }
@@ -40,7 +40,7 @@ double ContractOrthantBoxes(EngineContext& ctx, const std::vector<Objective>& ob
     }
     if (crossed) {
       // Only verified bounds enter the contraction when verification is on (above).
-      o.ProveEmpty({"crossed bounds", order, true, verify_on});
+      o.ProveEmpty({CertificateKind::kCrossedBounds, order, true, verify_on});
       continue;
     }
     o.box = next;

@@ -8,7 +8,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
+#include "dss/set_membership.hpp"
 
 namespace hw::dss {
 namespace {
@@ -44,13 +45,15 @@ Endpoint OutermostEndpoint(const std::vector<const Endpoint*>& endpoints, const 
   if (!out.note.empty()) out.note = fmt::format("piece {}: {}", piece_of[best] + 1, out.note);
   bool all_verified = true, any_unverified = false;
   for (const Endpoint* e : endpoints) {
-    if (e->status != "guaranteed") out.status = "conservative";
+    if (e->status != EndpointStatus::kGuaranteed) out.status = EndpointStatus::kConservative;
     out.tight = out.tight && e->tight;
     out.correction = std::max(out.correction, e->correction);
-    all_verified = all_verified && e->verification == "verified";
-    any_unverified = any_unverified || e->verification == "unverified";
+    all_verified = all_verified && e->verification == sdp::VerifyStatus::kVerified;
+    any_unverified = any_unverified || e->verification == sdp::VerifyStatus::kUnverified;
   }
-  out.verification = any_unverified ? "unverified" : all_verified ? "verified" : "off";
+  out.verification = any_unverified ? sdp::VerifyStatus::kUnverified
+                     : all_verified ? sdp::VerifyStatus::kVerified
+                                    : sdp::VerifyStatus::kNotRun;
   return out;
 }
 
@@ -87,9 +90,9 @@ OrthantReport CombinedOrthant(const std::vector<BoundsSummary>& pieces, std::siz
   int order = 0;
   for (const auto& p : pieces) {
     const OrthantReport& o = p.orthants[l];
-    const bool empty = o.status.rfind("empty", 0) == 0;
+    const bool empty = o.empty();
     all_empty = all_empty && empty;
-    any_failed = any_failed || o.status.rfind("failed", 0) == 0;
+    any_failed = any_failed || o.status == OrthantStatus::kFailed;
     if (empty && o.certificate) {
       all_verified = all_verified && o.certificate->verified;
       any_contracted = any_contracted || o.certificate->contracted_box;
@@ -100,10 +103,10 @@ OrthantReport CombinedOrthant(const std::vector<BoundsSummary>& pieces, std::siz
   }
   r.certificate.reset();
   if (all_empty) {
-    r.certificate = EmptinessCertificate{"pieces", order, any_contracted, all_verified};
-    r.status = r.certificate->status();
+    r.certificate = EmptinessCertificate{CertificateKind::kPieces, order, any_contracted, all_verified};
+    r.status = OrthantStatus::kEmpty;
   } else {
-    r.status = any_failed ? "failed (conservative fallback)" : "solved";
+    r.status = any_failed ? OrthantStatus::kFailed : OrthantStatus::kSolved;
   }
   return r;
 }
@@ -215,9 +218,9 @@ BoundsSummary CombinePieces(const std::vector<BoundsSummary>& pieces, const Para
   out.median_solve_seconds = medians[medians.size() / 2];
   for (std::size_t l = 0; l < first.orthants.size(); ++l) {
     out.orthants.push_back(CombinedOrthant(pieces, l));
-    const std::string& s = out.orthants.back().status;
-    if (s.rfind("empty", 0) == 0) ++out.orthants_empty;
-    else if (s.rfind("failed", 0) == 0) ++out.orthants_failed;
+    const OrthantStatus s = out.orthants.back().status;
+    if (s == OrthantStatus::kEmpty) ++out.orthants_empty;
+    else if (s == OrthantStatus::kFailed) ++out.orthants_failed;
     else ++out.orthants_solved;
   }
   std::vector<int> live;
@@ -268,19 +271,11 @@ ParameterBox ProvenBox(const BoundsSummary& summary, const ParameterBox& box) {
     const std::size_t k = IndexOf(summary.parameter_names, iv.name);
     if (k >= proven.size()) continue;
     auto side = proven[k];
-    if (iv.lower.verification == "verified") side.first = std::max(side.first, iv.lower.value);
-    if (iv.upper.verification == "verified") side.second = std::min(side.second, iv.upper.value);
+    if (iv.lower.verification == sdp::VerifyStatus::kVerified) side.first = std::max(side.first, iv.lower.value);
+    if (iv.upper.verification == sdp::VerifyStatus::kVerified) side.second = std::min(side.second, iv.upper.value);
     if (side.first < side.second) proven[k] = side;  // a point interval keeps its box side: no empty box side
   }
   return proven;
-}
-
-bool ValidAutoSplitRounds(int rounds, const std::string& executor, std::string* error) {
-  if (rounds < 0 || rounds > 5) return Fail(error, fmt::format("auto split: {} rounds; expected 0 (off) to 5", rounds));
-  if (rounds > 0 && executor == "mpi")
-    return Fail(error, "auto split: not under the mpi executor (its worker ranks cannot follow the cuts the "
-                       "coordinator chooses); use the fork executor, or give the cuts as a split");
-  return true;
 }
 
 bool AutoSplitOptions::IsValid(std::string* error) const {

@@ -13,12 +13,12 @@
 #include <utility>
 #include <vector>
 
+#include "dss/bounds_options.hpp"
+#include "dss/bounds_summary.hpp"
 #include "dss/hw_outer_set.hpp"
-#include "dss/set_membership.hpp"
 
 namespace hw::dss {
 
-using ParameterBox = std::vector<std::pair<double, double>>;
 
 // Cut points of one parameter: the box side of `parameter` splits at each of `values`.
 struct BoxCut {
@@ -68,9 +68,7 @@ struct AutoSplitOptions {
                                // the cut-off piece holds no certified point and can be proven empty
   bool IsValid(std::string* error) const;
 };
-// Automatic rounds: 0..5 (each round is a full run over the pieces of the shrunk box), and none under the executor
-// "mpi", whose worker ranks cannot follow the cuts the coordinator chooses.
-bool ValidAutoSplitRounds(int rounds, const std::string& executor, std::string* error);
+// (Its rounds' check, ValidAutoSplitRounds, is with the other settings' checks in dss/bounds_options.hpp.)
 
 // The cut that bounds `part` on its own: `margin` x the interval's width beyond its witnessed end.
 double CutBeyondWitness(const UnwitnessedPart& part, const BoundsSummary& summary, double margin);

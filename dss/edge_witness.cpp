@@ -46,7 +46,7 @@ double SlackWithAllowance(const Polynomial& g, const std::vector<double>& p) {
 }
 
 // The box centre, then `count` deterministic points in the box (seeded by the orthant).
-std::vector<std::vector<double>> StartsInBox(const Box& box, int count, int orthant) {
+std::vector<std::vector<double>> StartsInBox(const ParameterBox& box, int count, int orthant) {
   std::vector<std::vector<double>> starts;
   std::vector<double> center;
   for (const auto& [lo, hi] : box) center.push_back(0.5 * (lo + hi));
@@ -56,20 +56,20 @@ std::vector<std::vector<double>> StartsInBox(const Box& box, int count, int orth
 }
 
 // An outcome at the box edge: exact and verified by a feasible point (in this orthant, or in another one for a
-// "skipped" objective that cannot move the endpoint).
-JobOutcome AtEdge(const std::string& status, double edge, const std::string& origin, std::string message) {
+// skipped objective that cannot move the endpoint).
+JobOutcome AtEdge(JobStatus status, double edge, JobOrigin origin, std::string message) {
   JobOutcome r;
   r.status = status;
   r.bound = r.float_bound = edge;
   r.tight = true;
-  r.verification = "verified";
+  r.verification = sdp::VerifyStatus::kVerified;
   r.origin = origin;
   r.message = std::move(message);
   return r;
 }
 
 // The side of `box` an objective runs toward.
-double EdgeOf(const Box& box, const Objective& o) { return o.dir < 0 ? box[o.param].first : box[o.param].second; }
+double EdgeOf(const ParameterBox& box, const Objective& o) { return o.dir < 0 ? box[o.param].first : box[o.param].second; }
 
 }  // namespace
 
@@ -128,8 +128,27 @@ std::vector<FeasiblePoint> ExtremeFeasiblePoints(const std::vector<Objective>& o
   return extreme;
 }
 
+nlohmann::json AnswerWitnessJob(const JobContext& job, const nlohmann::json& spec) {
+  // Local extreme of one objective from the given starts in turn, until a start gives a feasible point.
+  const int l = spec.at("l");
+  const std::vector<int> rows = spec.at("rows").get<std::vector<int>>();
+  const int param = spec.at("param"), dir = spec.at("dir");
+  nlohmann::json answer{{"found", false}, {"solves", 0}};
+  for (const auto& start : spec.at("starts")) {
+    const auto w = LocalExtreme(job.prior_set(), l, param, dir, start.get<std::vector<double>>(),
+                                job.options().edge_witness.local, &rows);
+    answer["solves"] = answer["solves"].get<int>() + 1;
+    if (w.found) {
+      answer["found"] = true;
+      answer["point"] = w.point;
+      break;
+    }
+  }
+  return answer;
+}
+
 std::string WitnessSpec(const OrthantWork& w, const Objective& o, const std::vector<std::vector<double>>& starts) {
-  return nlohmann::json{{"kind", "witness"}, {"l", w.index}, {"param", o.param}, {"dir", o.dir}, {"starts", starts},
+  return nlohmann::json{{"kind", kWitnessJob}, {"l", w.index}, {"param", o.param}, {"dir", o.dir}, {"starts", starts},
                         {"rows", w.rows}}
       .dump();
 }
@@ -150,7 +169,7 @@ std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector
 namespace {
 
 // The bound of objective `o` that orthant l's box and sign constraints give alone.
-double SignBoxBound(const HwOuterSet& set, const Box& box, int l, const Objective& o) {
+double SignBoxBound(const HwOuterSet& set, const ParameterBox& box, int l, const Objective& o) {
   double bound = EdgeOf(box, o);
   const auto signs = set.orthant_signs(l);
   for (std::size_t k = 0; k < set.sign_polynomials().size(); ++k) {
@@ -172,7 +191,7 @@ std::optional<JobOutcome> SettleBySignBeyondWitness(const HwOuterSet& set, const
   if (std::isnan(witnessed)) return std::nullopt;
   const double sign_bound = SignBoxBound(set, w.box, w.index, o);
   if (o.dir < 0 ? sign_bound < witnessed : sign_bound > witnessed) return std::nullopt;
-  return AtEdge("skipped", sign_bound, "orthant sign constraint",
+  return AtEdge(JobStatus::kSkipped, sign_bound, JobOrigin::kSignConstraint,
                 fmt::format("the orthant's sign constraints bound {} at {:.9g}, at or beyond a certified feasible "
                             "value {:.9g}: it cannot move the endpoint", set.layout().names[o.param], sign_bound,
                             witnessed));
@@ -272,7 +291,7 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
     if (!(slack >= 0)) continue;
     std::string text;
     for (std::size_t i = 0; i < p.size(); ++i) text += fmt::format("{}{} = {:.9g}", i ? ", " : "", set.layout().names[i], p[i]);
-    result.settled[key] = AtEdge("solved", edge, "feasible point at the box edge",
+    result.settled[key] = AtEdge(JobStatus::kSolved, edge, JobOrigin::kFeasiblePointAtEdge,
                                  fmt::format("a feasible point attains the prior box edge (certified min slack "
                                              "{:.3g}): {}", slack, text));
     result.points[key] = p;
@@ -283,7 +302,7 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
     for (const auto* w : live)
       if (w->index != l)
         result.settled[{w->index, j}] =
-            AtEdge("skipped", EdgeOf(set.box(), objectives[j]), "box edge reached in another orthant",
+            AtEdge(JobStatus::kSkipped, EdgeOf(set.box(), objectives[j]), JobOrigin::kEdgeInOtherOrthant,
                    fmt::format("the interval already reaches the prior box edge (feasible point in orthant {})", l));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

@@ -23,8 +23,8 @@ namespace hw::dss {
 using ObjectiveKey = std::pair<int, int>;
 
 struct EdgeWitnessResult {
-  // Settled objectives: in the orthant whose point attains the edge ("solved", tight, origin "feasible point at
-  // the box edge"), and in the other live orthants ("skipped": the interval already reaches the box edge).
+  // Settled objectives: in the orthant whose point attains the edge (solved, tight, origin kFeasiblePointAtEdge),
+  // and in the other live orthants (skipped: the interval already reaches the box edge).
   std::map<ObjectiveKey, JobOutcome> settled;
   std::map<ObjectiveKey, std::vector<double>> points;  // the witness of each settling orthant (original units)
   // Per objective index: the most extreme value of its parameter over every certified feasible point found (in
@@ -63,13 +63,17 @@ std::optional<JobOutcome> SettleBySignBeyondWitness(const HwOuterSet& set, const
                                                     double witnessed);
 
 // The spec of a witness job: a local extreme of objective `o` over orthant w's rows (the kept ones), from
-// `starts` in turn until one gives a feasible point (MakeJobFunction answers {"found", "point", "solves"}).
+// `starts` in turn until one gives a feasible point (AnswerWitnessJob answers {"found", "point", "solves"}).
 std::string WitnessSpec(const OrthantWork& w, const Objective& o, const std::vector<std::vector<double>>& starts);
 
 // Runs witness jobs (spec, cache key) through the cache and the executor; answers in job order (an empty object
 // for a job that failed); adds their local solves to *solves; one progress step per job.
 std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector<std::pair<std::string, std::string>>& jobs,
                                            int* solves);
+
+// The witness job kind: {"kind": "witness", "l", "param", "dir", "starts", "rows"} -> {"found", "point", "solves"}.
+inline constexpr char kWitnessJob[] = "witness";
+nlohmann::json AnswerWitnessJob(const JobContext& job, const nlohmann::json& spec);
 
 EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
                                          const std::vector<Objective>& objectives,

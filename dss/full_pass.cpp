@@ -17,7 +17,7 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
   for (const auto& [key, r] : settled) {
     full[key] = r;
     const int o = key.second, dir = objectives[o].dir;
-    if (r.status == "solved" && (std::isnan(current[o]) || (dir < 0 ? r.bound < current[o] : r.bound > current[o])))
+    if (r.status == JobStatus::kSolved && (std::isnan(current[o]) || (dir < 0 ? r.bound < current[o] : r.bound > current[o])))
       current[o] = r.bound;
   }
   int total = 0;
@@ -37,7 +37,7 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
         const auto& c = cheap.at({w.index, o});
         // A failed cheap job cannot be used to skip: it must be solved. A skipped one carries a valid bound (the
         // box edge, or the orthant's sign bound beyond a witnessed value).
-        const double v = c.status == "solved" || c.status == "skipped" ? c.bound : (dir < 0 ? -INFINITY : INFINITY);
+        const double v = c.status == JobStatus::kSolved || c.status == JobStatus::kSkipped ? c.bound : (dir < 0 ? -INFINITY : INFINITY);
         // The endpoint is at least as extreme as the finished jobs' bounds and as a witnessed value.
         const double witness = StopBeyond(witnessed, o);
         const bool can_move = (std::isnan(current[o]) || (dir < 0 ? v < current[o] : v > current[o])) &&
@@ -63,7 +63,7 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
       // A job that stopped at a witnessed value has not converged: its blocks are no warm start for later waves.
       if (!outs[i].beyond_known_value)
         for (int r : RowsOfWorkingSet(*wave[i].orthant, outs[i].working_set)) active_rows[l].insert(r);
-      if (outs[i].status == "solved") {
+      if (outs[i].status == JobStatus::kSolved) {
         const int dir = objectives[o].dir;
         if (std::isnan(current[o]) || (dir < 0 ? outs[i].bound < current[o] : outs[i].bound > current[o]))
           current[o] = outs[i].bound;
@@ -76,7 +76,7 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
         auto c = cheap.at({w.index, o});
         c.message = fmt::format("skipped at order {}: its order-{} bound cannot move the interval", options.order,
                                 options.cheap_order);
-        if (c.status == "solved") c.status = "skipped";
+        if (c.status == JobStatus::kSolved) c.status = JobStatus::kSkipped;
         full[{w.index, o}] = c;
       }
   return full;

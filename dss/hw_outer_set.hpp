@@ -24,6 +24,10 @@
 
 namespace hw::dss {
 
+// A box of parameter space: [lo, hi] of every parameter, in the layout's order (the prior box, an orthant's
+// contracted box, a piece of a split box).
+using ParameterBox = std::vector<std::pair<double, double>>;
+
 struct HwStructure {
   std::vector<BasisFunction> input_basis;   // psi_1..psi_ngamma (gamma_1 = 1)
   std::vector<BasisFunction> output_basis;  // phi_1..phi_nalpha (alpha_1 = 1)
@@ -75,7 +79,7 @@ ParameterLayout MakeLayout(const HwStructure& s);
 // An affine change of variables p = center + radius .* p~ that maps the prior box onto [-1, 1]^n.
 struct Scaling {
   std::vector<double> center, radius;
-  static Scaling FromBox(const std::vector<std::pair<double, double>>& box);
+  static Scaling FromBox(const ParameterBox& box);
   std::vector<Polynomial> substitution() const;  // p_i as polynomials in p~
   double to_original(int i, double scaled) const { return center[i] + radius[i] * scaled; }
 };
@@ -90,7 +94,7 @@ struct DataConstraint {
 
 class HwOuterSet {
  public:
-  HwOuterSet(HwStructure structure, HwData data, int horizon, std::vector<std::pair<double, double>> box);
+  HwOuterSet(HwStructure structure, HwData data, int horizon, ParameterBox box);
 
   const ParameterLayout& layout() const { return layout_; }
   const Scaling& scaling() const { return scaling_; }
@@ -110,11 +114,11 @@ class HwOuterSet {
   std::vector<DataConstraint> data_constraints(int l) const;
   // Box constraints 1 - p~_i^2 >= 0.
   std::vector<Polynomial> box_constraints() const;
-  const std::vector<std::pair<double, double>>& box() const { return box_; }
+  const ParameterBox& box() const { return box_; }
   const HwStructure& structure() const { return structure_; }
   const HwData& data() const { return data_; }
   // The same data, model class and horizon in another box (a contracted one: same set inside it, new scaling).
-  HwOuterSet WithBox(std::vector<std::pair<double, double>> box) const { return {structure_, data_, horizon_, std::move(box)}; }
+  HwOuterSet WithBox(ParameterBox box) const { return {structure_, data_, horizon_, std::move(box)}; }
   // Numerical warnings about the data found at construction: basis values spanning more magnitudes than the
   // solvers resolve, or noise bands below the resolution of a basis value, each with the scaling to use.
   const std::vector<std::string>& warnings() const { return warnings_; }
@@ -144,7 +148,7 @@ class HwOuterSet {
   HwStructure structure_;
   HwData data_;
   int horizon_;
-  std::vector<std::pair<double, double>> box_;
+  ParameterBox box_;
   ParameterLayout layout_;
   Scaling scaling_;
   std::vector<Polynomial> scaled_vars_;

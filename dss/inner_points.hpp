@@ -41,7 +41,7 @@ struct FeasiblePoint {
 };
 
 // `count` deterministic pseudo-random points in `box` (a fixed-seed 64-bit LCG: the same starts on every machine).
-std::vector<std::vector<double>> PseudoRandomPointsInBox(const std::vector<std::pair<double, double>>& box,
+std::vector<std::vector<double>> PseudoRandomPointsInBox(const ParameterBox& box,
                                                          int count, uint64_t seed);
 
 // Locally extremises parameter k (dir = -1: min, +1: max) over D^ss(n) within orthant l and the prior box,

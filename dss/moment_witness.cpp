@@ -12,7 +12,7 @@ namespace hw::dss {
 
 namespace {
 
-std::vector<double> ClippedToBox(std::vector<double> p, const Box& box) {
+std::vector<double> ClippedToBox(std::vector<double> p, const ParameterBox& box) {
   for (std::size_t i = 0; i < p.size(); ++i) p[i] = std::clamp(p[i], box[i].first, box[i].second);
   return p;
 }
@@ -32,7 +32,7 @@ MomentWitnessResult FeasiblePointsFromMoments(const MomentWitnessOptions& option
     if (w.empty()) continue;
     for (int j : wanted) {
       const auto it = outcomes.find({w.index, j});
-      if (it == outcomes.end() || it->second.status != "solved") continue;
+      if (it == outcomes.end() || it->second.status != JobStatus::kSolved) continue;
       const auto& moments = it->second.first_moments;
       if (moments.size() != w.box.size()) continue;  // no solved round (or read from an older cache)
       const std::string spec = WitnessSpec(w, objectives[j], {ClippedToBox(moments, w.box)});

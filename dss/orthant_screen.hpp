@@ -17,10 +17,13 @@ struct ScreenOptions {
 
 struct ScreenResult {
   std::vector<int> alive;                 // orthants not proven empty, ascending
-  std::vector<std::string> status;        // per orthant: "empty (LP)" or "undecided"
   std::vector<std::optional<EmptinessCertificate>> certificates;  // per orthant: the LP certificate of an empty one
 };
 
 ScreenResult ScreenOrthants(const ScreenOptions& options, EngineContext& ctx);
+
+// The screen's job kind: {"kind": "lp", "l"} -> {"empty", "status", "verification"}.
+inline constexpr char kScreenJob[] = "lp";
+nlohmann::json AnswerScreenJob(const JobContext& job, const nlohmann::json& spec);
 
 }  // namespace hw::dss

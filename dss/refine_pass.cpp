@@ -13,7 +13,7 @@ namespace {
 
 bool Beyond(int dir, double a, double b) { return dir < 0 ? a < b : a > b; }
 
-bool Usable(const JobOutcome& r) { return r.status == "solved" || r.status == "skipped"; }
+bool Usable(const JobOutcome& r) { return r.status == JobStatus::kSolved || r.status == JobStatus::kSkipped; }
 
 // Solved outcomes of live orthants among `wanted` that are their objective's endpoint (no other live orthant's
 // solved or skipped bound lies beyond) and that `qualifies` accepts. Ascending order.
@@ -28,7 +28,7 @@ std::vector<std::pair<int, int>> EndpointsWhere(const std::vector<Objective>& ob
     if (!w.empty()) alive.insert(w.index);
   for (const auto& [key, r] : full) {
     const auto [l, o] = key;
-    if (!alive.count(l) || !wanted_set.count(o) || r.status != "solved" || !qualifies(o, r)) continue;
+    if (!alive.count(l) || !wanted_set.count(o) || r.status != JobStatus::kSolved || !qualifies(o, r)) continue;
     const int dir = objectives[o].dir;
     bool endpoint = true;
     for (const auto& [other_key, other] : full)
@@ -102,8 +102,9 @@ RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext
       const int dir = objectives[job_key[i].second].dir;
       // Infeasible: the orthant is empty (RunRelaxationJobs recorded the certificate). Solved: both bounds hold,
       // the tighter one is kept.
-      const bool valid = again.status == "solved" && (!verify_on || again.verification == "verified");
-      if (again.status == "infeasible" || (valid && Beyond(-dir, again.bound, kept.bound))) {
+      const bool valid =
+          again.status == JobStatus::kSolved && (!verify_on || again.verification == sdp::VerifyStatus::kVerified);
+      if (again.status == JobStatus::kInfeasible || (valid && Beyond(-dir, again.bound, kept.bound))) {
         kept = again;
         ++result.bounds_tightened;
       }

@@ -163,6 +163,31 @@ RowReductionResult ReduceDataRows(const RowReductionOptions& options, const std:
 
 namespace hw::dss {
 
+nlohmann::json AnswerReduceJob(const JobContext& job, const nlohmann::json& spec) {
+  const int l = spec.at("l");
+  const ParameterBox box = spec.at("box").get<ParameterBox>();
+  const HwOuterSet& set = job.set_in(box);
+  const auto& all_rows = job.rows_in(box, l);
+  const int only_step = spec.value("step", 0);
+  std::vector<Polynomial> rows;
+  std::vector<int> steps, index;
+  for (std::size_t i = 0; i < all_rows.size(); ++i) {
+    if (only_step != 0 && all_rows[i].s != only_step) continue;
+    rows.push_back(all_rows[i].g);
+    steps.push_back(all_rows[i].s);
+    index.push_back(static_cast<int>(i));
+  }
+  std::vector<Polynomial> fixed = set.box_constraints();
+  for (auto& g : set.sign_constraints(l)) fixed.push_back(std::move(g));
+  const auto r = ReduceDataRows(job.options().reduction, rows, steps, fixed);
+  std::vector<int> kept;  // indices into all_rows
+  for (int k : r.kept) kept.push_back(index[k]);
+  nlohmann::json counts = nlohmann::json::array();
+  for (const auto& c : r.per_step)
+    counts.push_back({{"step", c.step}, {"rows", c.rows}, {"kept", c.kept}, {"iteration_limited", c.iteration_limited}});
+  return {{"kept", kept}, {"per_step", counts}, {"linear_programs", r.linear_programs}, {"seconds", r.seconds}};
+}
+
 void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants) {
   // One job per (orthant, horizon step): rows of different steps never combine, so the result is the same as one
   // job per orthant, while the steps run in parallel and each finished step shows in the progress.
@@ -179,7 +204,7 @@ void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants) {
       std::string key = fmt::format("reduce_l{}_s{}", o.index, s);
       if (o.box != ctx.set.box()) key += "_b" + BoxHash(o.box);
       if (!ctx.options.reduction.enabled) key += "_off";
-      jobs.push_back({nlohmann::json{{"kind", "reduce"}, {"l", o.index}, {"box", o.box}, {"step", s}}.dump(), key});
+      jobs.push_back({nlohmann::json{{"kind", kReduceJob}, {"l", o.index}, {"box", o.box}, {"step", s}}.dump(), key});
       job_of.push_back({k, s});
     }
   }

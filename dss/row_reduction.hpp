@@ -50,4 +50,9 @@ namespace hw::dss {
 // orthant; the kept rows and the counts per step land in each OrthantWork).
 void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants);
 
+// The reduction's job kind: {"kind": "reduce", "l", "box", ["step"]} -> {"kept", "per_step", "linear_programs",
+// "seconds"}; rows never combine across horizon steps, so each step may be a job of its own (no "step": all).
+inline constexpr char kReduceJob[] = "reduce";
+nlohmann::json AnswerReduceJob(const JobContext& job, const nlohmann::json& spec);
+
 }  // namespace hw::dss

@@ -7,13 +7,14 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "dss/aggregate.hpp"
 #include "dss/bound_jobs.hpp"
 #include "dss/box_contraction.hpp"
 #include "dss/cheap_pass.hpp"
 #include "dss/edge_witness.hpp"
 #include "dss/full_pass.hpp"
+#include "dss/job_function.hpp"
 #include "dss/moment_witness.hpp"
 #include "dss/orthant_screen.hpp"
 #include "dss/refine_pass.hpp"
@@ -113,12 +114,6 @@ std::vector<int> WantedParameters(const BoundsOptions& options, const HwOuterSet
   return wanted;
 }
 
-// Sets *error (when given) and returns false: the tail of every IsValid-style check below.
-bool Fail(std::string* error, std::string message) {
-  if (error) *error = std::move(message);
-  return false;
-}
-
 // Each interval's range over the feasible points (ParameterInterval::witnessed_lower/upper).
 void AttachWitnessedRanges(const HwOuterSet& set, const std::vector<FeasiblePoint>& points,
                            std::vector<ParameterInterval>& intervals) {
@@ -137,20 +132,21 @@ void AttachWitnessedRanges(const HwOuterSet& set, const std::vector<FeasiblePoin
 void ReportOrthants(const HwOuterSet& set, const ScreenResult& screen, const std::vector<OrthantWork>& orthants,
                     const PassOutcomes& full, const std::vector<int>& wanted_objectives, BoundsSummary& summary) {
   summary.orthants_total = set.num_orthants();
-  std::vector<std::string> status = screen.status;
   std::vector<std::optional<EmptinessCertificate>> certificate = screen.certificates;
+  std::vector<OrthantStatus> status;
+  for (const auto& c : certificate) status.push_back(c ? OrthantStatus::kEmpty : OrthantStatus::kUndecided);
   for (const auto& w : orthants) {
     if (w.empty()) certificate[w.index] = w.certificate;
     bool failed = false;
     for (int o : wanted_objectives)
-      if (full.count({w.index, o}) && full.at({w.index, o}).status == "failed") failed = true;
-    status[w.index] = w.empty() ? w.status : failed ? "failed (conservative fallback)" : "solved";
+      if (full.count({w.index, o}) && full.at({w.index, o}).status == JobStatus::kFailed) failed = true;
+    status[w.index] = w.empty() ? OrthantStatus::kEmpty : failed ? OrthantStatus::kFailed : OrthantStatus::kSolved;
     summary.row_reduction.push_back({{"orthant", w.index}, {"per_step", w.reduction}});
     if (!w.empty() && w.box != set.box()) summary.orthant_boxes.push_back({w.index, w.box});
   }
   for (int l = 0; l < set.num_orthants(); ++l) {
-    if (status[l].rfind("empty", 0) == 0) ++summary.orthants_empty;
-    else if (status[l].rfind("failed", 0) == 0) ++summary.orthants_failed;
+    if (status[l] == OrthantStatus::kEmpty) ++summary.orthants_empty;
+    else if (status[l] == OrthantStatus::kFailed) ++summary.orthants_failed;
     else ++summary.orthants_solved;
     summary.orthants.push_back({l, sign_text(set, l), status[l], certificate[l]});
   }
@@ -173,159 +169,6 @@ void CopyJobCounters(EngineCounters counters, BoundsSummary& summary) {
 
 }  // namespace
 
-bool ValidOrder(int order, int horizon, std::string* error) {
-  const int minimal = MinimalOrder(horizon);
-  if (order < minimal)
-    return Fail(error, fmt::format("order {} is below the minimal order ceil((n+1)/2) = {} of horizon {}; leave the "
-                                   "order unset for the minimal order",
-                                   order, minimal, horizon));
-  if (order > kMaxOrder)
-    return Fail(error, fmt::format("order {} is above the largest relaxation order {}", order, kMaxOrder));
-  return true;
-}
-
-bool ValidThreads(int threads, std::string* error) {
-  if (threads >= 0) return true;
-  return Fail(error, fmt::format("threads {} is negative; give 0 (one job per core) or the number of jobs", threads));
-}
-
-bool ValidContractionPasses(int passes, std::string* error) {
-  if (passes >= 0 && passes <= 10) return true;
-  return Fail(error, fmt::format("contraction_passes {} is out of range 0..10 (0 = no box contraction)", passes));
-}
-
-bool ValidStoppedShortRefinements(int refinements, std::string* error) {
-  if (refinements >= 0) return true;
-  return Fail(error, fmt::format("stopped_short_refinements {} is negative; give 0 (never) or more", refinements));
-}
-
-bool ValidEndpointRefinements(int refinements, std::string* error) {
-  if (refinements >= 0 && refinements <= kMaxEndpointRefinements) return true;
-  return Fail(error, fmt::format("endpoint_refinements {} is out of range 0..{} (0 = never)", refinements,
-                                 kMaxEndpointRefinements));
-}
-
-bool ValidBoundsSolver(const std::string& name, std::string* error) {
-  if (name == "auto") return true;
-  if (sdp::ValidSolverName(name, nullptr)) return true;
-  return Fail(error, fmt::format("solver '{}' unknown; expected auto (a backend per relaxation), {}", name,
-                                 fmt::join(sdp::AvailableSolvers(), ", ")));
-}
-
-std::string SolverForOrder(const std::string& name, int /*order*/, int /*block_order_cap*/) {
-  return name == "auto" ? "csdp" : name;
-}
-
-bool BoundsOptions::IsValid(std::string* error) const {
-  auto fail = [&](std::string m) { return Fail(error, std::move(m)); };
-  if (order < 1 || order > kMaxOrder) return fail(fmt::format("order {} is out of range 1..{}", order, kMaxOrder));
-  if (!ValidThreads(threads, error) || !ValidContractionPasses(contraction_passes, error)) return false;
-  if (contraction_max_rounds < 1) return fail("contraction_max_rounds must be >= 1");
-  if (!ValidStoppedShortRefinements(stopped_short_refinements, error)) return false;
-  if (!ValidEndpointRefinements(endpoint_refinements, error)) return false;
-  if (!(contraction_min_shrink >= 0 && contraction_min_shrink < 1)) return fail("contraction_min_shrink must lie in [0, 1)");
-  if (!ValidBoundsSolver(solver, error)) return false;
-  if (!reduction.IsValid(error)) return false;
-  if (!edge_witness.IsValid(error)) return false;
-  return generation.IsValid(error);
-}
-
-std::string EmptinessCertificate::status() const {
-  if (kind == "lp") return "empty (LP)";
-  if (kind == "pieces") return order > 0 ? fmt::format("empty in every piece (up to order {})", order) : "empty in every piece (LP)";
-  return fmt::format("empty (order {}{}{})", order, contracted_box ? ", contracted box" : "",
-                     kind == "crossed bounds" ? ", bounds cross" : "");
-}
-
-nlohmann::json EmptinessCertificate::to_json() const {
-  return {{"kind", kind}, {"order", kind == "lp" ? nlohmann::json(nullptr) : nlohmann::json(order)},
-          {"contracted_box", contracted_box}, {"verified", verified}};
-}
-
-bool BoundsSummary::invalidated() const {
-  if (orthants_total == 0 || orthants_empty != orthants_total) return false;
-  for (const auto& o : orthants)
-    if (o.status.rfind("empty", 0) != 0) return false;
-  return true;
-}
-
-bool BoundsSummary::all_guaranteed() const {
-  if (invalidated()) return true;  // every orthant proven empty: no endpoint to guarantee
-  for (const auto& iv : intervals)
-    for (const Endpoint* e : {&iv.lower, &iv.upper})
-      // A floating-point bound that verification could not prove is not called guaranteed.
-      if (e->status != "guaranteed" || e->verification == "unverified") return false;
-  return true;
-}
-
-nlohmann::json BoundsSummary::to_json() const {
-  nlohmann::json j;
-  j["order"] = order;
-  j["horizon"] = horizon;
-  j["solver"] = solver;
-  j["solver_option"] = solver_option;
-  j["relaxation"] = relaxation;
-  j["executor"] = executor;
-  nlohmann::json box_j = nlohmann::json::array();
-  for (std::size_t i = 0; i < box.size(); ++i)
-    box_j.push_back({{"parameter", parameter_names[i]}, {"lo", box[i].first}, {"hi", box[i].second}});
-  j["prior_box"] = box_j;
-  j["prior_box_note"] = "intervals are guaranteed for parameters inside this box (a prior assumption)";
-  const bool none = invalidated();
-  j["invalidated"] = none;
-  if (none)
-    j["verdict"] = "no parameter in the prior box explains the data within the noise bound: the model class "
-                   "(orders, bases) or the noise bound is wrong (every orthant is proven empty; see `hwbounds diagnose`)";
-  auto ep = [none](const Endpoint& e) {
-    return nlohmann::json{{"value", none ? nlohmann::json(nullptr) : nlohmann::json(e.value)}, {"status", e.status}, {"note", e.note}, {"orthant", e.orthant},
-                          {"tight", e.tight}, {"verification", e.verification}, {"correction", e.correction}};
-  };
-  auto witnessed = [](const ParameterInterval& iv) {
-    if (!iv.witnessed_lower || !iv.witnessed_upper) return nlohmann::json(nullptr);
-    return nlohmann::json{{"lower", *iv.witnessed_lower}, {"upper", *iv.witnessed_upper}};
-  };
-  for (const auto& iv : intervals)
-    j["intervals"].push_back({{"parameter", iv.name}, {"lower", ep(iv.lower)}, {"upper", ep(iv.upper)},
-                              {"half_width", none ? nlohmann::json(nullptr) : nlohmann::json(iv.half_width())},
-                              {"witnessed", witnessed(iv)}});
-  j["feasible_points"] = nlohmann::json::array();
-  for (const auto& p : feasible_points) {
-    nlohmann::json point;
-    for (std::size_t i = 0; i < p.point.size() && i < parameter_names.size(); ++i) point[parameter_names[i]] = p.point[i];
-    j["feasible_points"].push_back(
-        {{"orthant", p.orthant}, {"point", point}, {"certified_min_slack", p.certified_min_slack}});
-  }
-  for (const auto& o : orthants)
-    j["orthants"].push_back({{"index", o.index}, {"signs", o.signs}, {"status", o.status},
-                             {"certificate", o.certificate ? o.certificate->to_json() : nlohmann::json(nullptr)}});
-  j["counts"] = {{"orthants_total", orthants_total}, {"orthants_proven_empty", orthants_empty},
-                 {"orthants_solved", orthants_solved}, {"orthants_failed", orthants_failed},
-                 {"sdp_jobs", sdp_jobs}, {"sdp_solves", sdp_solves}, {"jobs_from_cache", jobs_from_cache},
-                 {"jobs_stopped_beyond_witness", jobs_stopped_beyond_witness},
-                 {"jobs_settled_by_sign", jobs_settled_by_sign},
-                 {"edge_witness_settled", edge_witness_settled}, {"edge_witness_solves", edge_witness_solves},
-                 {"moment_witness_jobs", moment_witness_jobs}, {"moment_witness_found", moment_witness_found}};
-  j["timing"] = {{"wall_seconds", wall_seconds}, {"median_solve_seconds", median_solve_seconds},
-                 {"solve_seconds", solve_seconds}, {"verify_seconds", verify_seconds},
-                 {"edge_witness_seconds", edge_witness_seconds}, {"moment_witness_seconds", moment_witness_seconds}};
-  j["largest_sdp"] = {{"moments", largest_moments}, {"blocks", largest_blocks}};
-  j["all_guaranteed"] = all_guaranteed();
-  j["contraction_passes_run"] = contraction_passes_run;
-  j["stopped_short_refined"] = {{"jobs", refine_jobs}, {"tightened", refine_tightened}};
-  j["endpoints_refined"] = {{"jobs", endpoint_refine_jobs}, {"tightened", endpoint_refine_tightened}};
-  j["row_reduction"] = row_reduction;
-  j["bound_sources"] = bound_sources;
-  j["clipped_to_prior_box"] = clipped_to_box;
-  if (!pieces.empty()) j["pieces"] = pieces;
-  if (!auto_split.is_null()) j["auto_split"] = auto_split;
-  for (const auto& [l, b] : orthant_boxes) {
-    nlohmann::json bj = nlohmann::json::array();
-    for (std::size_t i = 0; i < b.size(); ++i)
-      bj.push_back({{"parameter", parameter_names[i]}, {"lo", b[i].first}, {"hi", b[i].second}});
-    j["contracted_boxes"].push_back({{"orthant", l}, {"box", bj}});
-  }
-  return j;
-}
 
 BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSet& set,
                             const std::function<void(const BoundsProgress&)>& progress) {
@@ -450,7 +293,7 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.moment_witness_jobs = from_moments.jobs;
   summary.moment_witness_found = static_cast<int>(from_moments.feasible_points.size());
   summary.moment_witness_seconds = from_moments.seconds;
-  for (const auto& [key, r] : edges.settled) summary.edge_witness_settled += r.status == "solved" ? 1 : 0;
+  for (const auto& [key, r] : edges.settled) summary.edge_witness_settled += r.status == JobStatus::kSolved ? 1 : 0;
   CopyJobCounters(counters, summary);
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return summary;

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 
 namespace hw::exact {
 namespace {

@@ -16,7 +16,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
 #include "estimators/brouri/workflow.hpp"
 
 namespace {

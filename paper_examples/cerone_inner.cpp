@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_write.hpp"
 #include "core/cerone_example.hpp"
-#include "core/csv_table.hpp"
 #include "dss/hw_outer_set.hpp"
 #include "dss/inner_points.hpp"
 #include "paper_examples/cerone/paper_table.hpp"

@@ -16,7 +16,7 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/signal_stats.hpp"
 

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_write.hpp"
 #include "core/csv_table.hpp"
 #include "core/hw_model.hpp"
 #include "estimators/esmaeilani/estimator.hpp"

@@ -116,18 +116,20 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   a.structure.output_basis = dss::parse_basis(a.output_basis);
   RequireValid(a.structure);
   RequireValid(data);
-  // The CLI's checks of the same options (cli/cmd_bounds.cpp, CheckBoundsOptions).
-  Require([&](std::string* e) { return dss::ValidHorizon(a.horizon, e); });
-  if (a.order_given) Require([&](std::string* e) { return dss::ValidOrder(a.options.order, a.horizon, e); });
+  // The CLI's checks of the same settings (dss::SettingChecks).
+  dss::BoundsSettings settings;
+  settings.horizon = a.horizon;
+  if (a.order_given) settings.order = a.options.order;
+  settings.solver = a.options.solver;
+  settings.threads = a.options.threads;
+  settings.executor = a.executor;
+  settings.contraction_passes = a.options.contraction_passes;
+  settings.row_block_order = a.options.generation.block_order_cap;
+  settings.stopped_short_refinements = a.options.stopped_short_refinements;
+  settings.endpoint_refinements = a.options.endpoint_refinements;
+  settings.auto_split_rounds = a.auto_split.rounds;
+  for (const auto& check : dss::SettingChecks(settings)) Require(check.valid);
   a.options.order = a.order_given ? a.options.order : dss::MinimalOrder(a.horizon);
-  Require([&](std::string* e) { return dss::ValidBoundsSolver(a.options.solver, e); });
-  Require([&](std::string* e) { return dss::ValidThreads(a.options.threads, e); });
-  Require([&](std::string* e) { return sdp::ValidExecutorName(a.executor, e); });
-  Require([&](std::string* e) { return dss::ValidContractionPasses(a.options.contraction_passes, e); });
-  Require([&](std::string* e) { return pop::ValidBlockOrderCap(a.options.generation.block_order_cap, e); });
-  Require([&](std::string* e) { return dss::ValidStoppedShortRefinements(a.options.stopped_short_refinements, e); });
-  Require([&](std::string* e) { return dss::ValidEndpointRefinements(a.options.endpoint_refinements, e); });
-  Require([&](std::string* e) { return dss::ValidAutoSplitRounds(a.auto_split.rounds, a.executor, e); });
   if (a.executor == "mpi")
     throw py::value_error(
         "executor 'mpi' runs under mpirun from the CLI (`hwbounds bounds --executor mpi`); use "
@@ -139,13 +141,13 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
   const std::vector<dss::BoxCut> cuts = SplitFromPython(split, names, set.box());
   // Ctrl-C is checked while the engine waits for its jobs and at every progress report.
   a.options.executor->set_interrupt_check(CheckPythonSignals);
-  auto report = [&progress](const dss::BoundsProgress& p) {
+  auto on_progress = [&progress](const dss::BoundsProgress& p) {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (!progress.is_none()) progress(ProgressDict(p));
   };
   const auto summary = WithoutGil([&] {
-    return dss::ComputeBoundsWithAutoSplit(a.options, set, cuts, a.auto_split, report);
+    return dss::ComputeBoundsWithAutoSplit(a.options, set, cuts, a.auto_split, on_progress);
   });
   nlohmann::json j = summary.to_json();
   j["data"] = source;

@@ -1,5 +1,5 @@
 // PYBIND11_MODULE(hwbounds): the engine of the `hwbounds` CLI from Python (docs/python.md).
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "python/py_module.hpp"
 
 PYBIND11_MODULE(hwbounds, m) {

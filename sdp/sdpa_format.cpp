@@ -7,7 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
+#include "core/input_error.hpp"
 
 namespace hw::sdp {
 

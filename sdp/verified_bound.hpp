@@ -13,6 +13,7 @@
 //
 // Infeasibility: with c = 0 the same bound reads 0 >= bound for every feasible y, so a verified bound > 0
 // proves that the LMI (intersected with the a-priori box) has no solution.
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,9 @@ struct VerifyOptions {
 
 enum class VerifyStatus { kNotRun, kVerified, kUnverified };
 std::string ToString(VerifyStatus s);  // "off", "verified", "unverified"
+// JSON holds the name (nlohmann::json finds this by argument-dependent lookup).
+inline void to_json(nlohmann::json& j, VerifyStatus s) { j = ToString(s); }
+inline std::ostream& operator<<(std::ostream& os, VerifyStatus s) { return os << ToString(s); }
 
 struct VerifiedBound {
   VerifyStatus status = VerifyStatus::kNotRun;

@@ -11,11 +11,11 @@ namespace {
 
 JobOutcome Solved(double bound) {
   JobOutcome r;
-  r.status = "solved";
+  r.status = JobStatus::kSolved;
   r.bound = r.float_bound = bound;
   r.tight = true;
-  r.verification = "verified";
-  r.origin = "final round";
+  r.verification = sdp::VerifyStatus::kVerified;
+  r.origin = JobOrigin::kFinalRound;
   return r;
 }
 
@@ -68,22 +68,22 @@ TEST(Aggregate, InsideTheBoxNothingIsClippedAndTheExtremeOrthantWins) {
   EXPECT_EQ(r.intervals[0].lower.value, 0.1);
   EXPECT_EQ(r.intervals[0].upper.value, 1.9);
   EXPECT_FALSE(r.clipped_to_box);
-  EXPECT_EQ(r.intervals[0].lower.status, "guaranteed");
+  EXPECT_EQ(r.intervals[0].lower.status, EndpointStatus::kGuaranteed);
 }
 
 TEST(Aggregate, AFailedJobFallsBackToTheBoxEdgeAndKeepsItsOrthant) {
   Fixture f;
   f.outcomes[{3, 0}] = Solved(0.2);
   JobOutcome failed;
-  failed.status = "failed";
+  failed.status = JobStatus::kFailed;
   failed.message = "solver trouble";
   f.outcomes[{7, 0}] = failed;
   f.outcomes[{3, 1}] = Solved(1.7);
   f.outcomes[{7, 1}] = Solved(1.9);
   const AggregateResult r = f.Run();
   EXPECT_EQ(r.intervals[0].lower.value, -2.0);  // orthant 7's box edge: valid, conservative
-  EXPECT_EQ(r.intervals[0].lower.status, "conservative");
-  EXPECT_EQ(r.sources.at("box edge"), 1);
+  EXPECT_EQ(r.intervals[0].lower.status, EndpointStatus::kConservative);
+  EXPECT_EQ(r.sources.at(BoundSource::kBoxEdge), 1);
 }
 
 // An order-delta job that stopped short can end looser than the cheap order's bound of the same orthant; both
@@ -106,10 +106,10 @@ TEST(Aggregate, ACheapBoundTighterThanAShortOrderDeltaBoundIsUsed) {
       AggregateIntervals(AggregateOptions{true, 3, 2}, f.set, f.objectives, {4}, cheap, full, f.orthants);
   EXPECT_EQ(r.intervals[0].lower.value, 0.30);
   EXPECT_EQ(r.intervals[0].lower.orthant, 3);
-  EXPECT_EQ(r.intervals[0].lower.status, "guaranteed");
+  EXPECT_EQ(r.intervals[0].lower.status, EndpointStatus::kGuaranteed);
   EXPECT_FALSE(r.intervals[0].lower.tight);
   EXPECT_EQ(r.intervals[0].upper.value, 1.85);
-  EXPECT_EQ(r.sources.at("cheap order (tighter than an order-delta job that stopped short)"), 2);
+  EXPECT_EQ(r.sources.at(BoundSource::kCheapOrderTighter), 2);
 }
 
 }  // namespace

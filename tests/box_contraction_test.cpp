@@ -224,8 +224,8 @@ TEST(BoxContraction, KeepsTheTruthAndNeverWidensAnInterval) {
     EXPECT_LE(c.lower.value, kTruth[k]);
     EXPECT_GE(c.upper.value, kTruth[k]);
     // A smaller box gives a tighter (or equal) relaxation; 1e-6 for solver accuracy.
-    if (p.lower.status == "guaranteed" && c.lower.status == "guaranteed") EXPECT_GE(c.lower.value, p.lower.value - 1e-6);
-    if (p.upper.status == "guaranteed" && c.upper.status == "guaranteed") EXPECT_LE(c.upper.value, p.upper.value + 1e-6);
+    if (p.lower.status == EndpointStatus::kGuaranteed && c.lower.status == EndpointStatus::kGuaranteed) EXPECT_GE(c.lower.value, p.lower.value - 1e-6);
+    if (p.upper.status == EndpointStatus::kGuaranteed && c.upper.status == EndpointStatus::kGuaranteed) EXPECT_LE(c.upper.value, p.upper.value + 1e-6);
     // The data pin every parameter well inside the prior box, so the contraction must have moved.
     EXPECT_LT(c.half_width(), 2.5);
   }
@@ -277,8 +277,8 @@ TEST(BoxContraction, TheFullPassRunsInTheBoxesOfTheCheapBounds) {
   for (std::size_t k = 0; k < 3; ++k) {
     const auto& c = contracted.intervals[k];
     SCOPED_TRACE(c.name);
-    EXPECT_EQ(c.lower.status, "guaranteed");
-    EXPECT_EQ(c.upper.status, "guaranteed");
+    EXPECT_EQ(c.lower.status, EndpointStatus::kGuaranteed);
+    EXPECT_EQ(c.upper.status, EndpointStatus::kGuaranteed);
     EXPECT_LE(c.lower.value, kTruth[k]);
     EXPECT_GE(c.upper.value, kTruth[k]);
     for (const auto* other : {&prior_box.intervals[k], &order2.intervals[k]}) {

@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "core/cerone_example.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "dss/box_split.hpp"
 #include "tests/seeded_example.hpp"
 
@@ -50,13 +50,14 @@ TEST(BoxPieces, BadCutsAreNamed) {
 }
 
 // A piece's summary with one interval [lo, hi] of "p" and one orthant of the given status.
-BoundsSummary Piece(double lo, double hi, const std::string& orthant_status, const std::string& verification = "verified") {
+BoundsSummary Piece(double lo, double hi, OrthantStatus orthant_status,
+                    sdp::VerifyStatus verification = sdp::VerifyStatus::kVerified) {
   BoundsSummary s;
   s.parameter_names = kNames;
   s.orthants_total = 1;
   OrthantReport o{0, "p+", orthant_status, std::nullopt};
-  if (orthant_status.rfind("empty", 0) == 0) {
-    o.certificate = EmptinessCertificate{"relaxation", 2, false, verification == "verified"};
+  if (orthant_status == OrthantStatus::kEmpty) {
+    o.certificate = EmptinessCertificate{CertificateKind::kRelaxation, 2, false, verification == sdp::VerifyStatus::kVerified};
     s.orthants_empty = 1;
   } else {
     s.orthants_solved = 1;
@@ -64,25 +65,25 @@ BoundsSummary Piece(double lo, double hi, const std::string& orthant_status, con
   s.orthants.push_back(o);
   ParameterInterval iv;
   iv.name = "p";
-  iv.lower = {lo, "guaranteed", "", 0, true, verification, 0.0};
-  iv.upper = {hi, "guaranteed", "", 0, true, verification, 0.0};
+  iv.lower = {lo, EndpointStatus::kGuaranteed, "", 0, true, verification, 0.0};
+  iv.upper = {hi, EndpointStatus::kGuaranteed, "", 0, true, verification, 0.0};
   s.intervals.push_back(iv);
   s.sdp_jobs = 3;
   return s;
 }
 
 TEST(CombinePieces, HullOverTheLivePiecesWithTheWeakestStatus) {
-  BoundsSummary a = Piece(-0.5, 0.1, "solved");
-  BoundsSummary b = Piece(0.0, 0.7, "solved");
-  b.intervals[0].upper.status = "conservative";
+  BoundsSummary a = Piece(-0.5, 0.1, OrthantStatus::kSolved);
+  BoundsSummary b = Piece(0.0, 0.7, OrthantStatus::kSolved);
+  b.intervals[0].upper.status = EndpointStatus::kConservative;
   b.intervals[0].upper.note = "fallback";
-  const BoundsSummary empty = Piece(-9, 9, "empty (order 2)");  // proven empty: its endpoints do not count
+  const BoundsSummary empty = Piece(-9, 9, OrthantStatus::kEmpty);  // proven empty: its endpoints do not count
   const auto hull = CombinePieces({a, empty, b}, kBox);
   ASSERT_EQ(hull.intervals.size(), 1u);
   EXPECT_EQ(hull.intervals[0].lower.value, -0.5);
   EXPECT_EQ(hull.intervals[0].upper.value, 0.7);
-  EXPECT_EQ(hull.intervals[0].lower.status, "guaranteed");
-  EXPECT_EQ(hull.intervals[0].upper.status, "conservative");
+  EXPECT_EQ(hull.intervals[0].lower.status, EndpointStatus::kGuaranteed);
+  EXPECT_EQ(hull.intervals[0].upper.status, EndpointStatus::kConservative);
   EXPECT_EQ(hull.intervals[0].upper.note, "piece 3: fallback");
   EXPECT_EQ(hull.sdp_jobs, 9);
   EXPECT_EQ(hull.pieces.size(), 3u);
@@ -92,25 +93,26 @@ TEST(CombinePieces, HullOverTheLivePiecesWithTheWeakestStatus) {
   EXPECT_EQ(hull.box, kBox);
 
   // One piece's floating-point bound that verification could not prove makes the hull's endpoint unverified.
-  const BoundsSummary c = Piece(-0.2, 0.2, "solved", "unverified");
+  const BoundsSummary c = Piece(-0.2, 0.2, OrthantStatus::kSolved, sdp::VerifyStatus::kUnverified);
   const auto mixed = CombinePieces({a, c}, kBox);
-  EXPECT_EQ(mixed.intervals[0].lower.verification, "unverified");
+  EXPECT_EQ(mixed.intervals[0].lower.verification, sdp::VerifyStatus::kUnverified);
   EXPECT_FALSE(mixed.all_guaranteed());
 }
 
 TEST(CombinePieces, EveryPieceEmptyInvalidatesTheModelWithAVerifiedCertificateOnlyIfAllAre) {
-  const auto all = CombinePieces({Piece(0, 0, "empty (LP)"), Piece(0, 0, "empty (order 2)")}, kBox);
+  const auto all = CombinePieces({Piece(0, 0, OrthantStatus::kEmpty), Piece(0, 0, OrthantStatus::kEmpty)}, kBox);
   EXPECT_TRUE(all.invalidated());
   ASSERT_TRUE(all.orthants[0].certificate);
-  EXPECT_EQ(all.orthants[0].certificate->kind, "pieces");
+  EXPECT_EQ(all.orthants[0].certificate->kind, CertificateKind::kPieces);
   EXPECT_TRUE(all.orthants[0].certificate->verified);
-  EXPECT_EQ(all.orthants[0].status, "empty in every piece (up to order 2)");
-  const auto weak = CombinePieces({Piece(0, 0, "empty (LP)"), Piece(0, 0, "empty (order 2)", "off")}, kBox);
+  EXPECT_EQ(all.orthants[0].status_text(), "empty in every piece (up to order 2)");
+  const auto weak = CombinePieces(
+      {Piece(0, 0, OrthantStatus::kEmpty), Piece(0, 0, OrthantStatus::kEmpty, sdp::VerifyStatus::kNotRun)}, kBox);
   EXPECT_FALSE(weak.orthants[0].certificate->verified);
 }
 
 TEST(LargestUnwitnessedPart, TheWidestSideNoCertifiedPointReaches) {
-  BoundsSummary s = Piece(-1.0, 3.0, "solved");
+  BoundsSummary s = Piece(-1.0, 3.0, OrthantStatus::kSolved);
   EXPECT_FALSE(LargestUnwitnessedPart(s)) << "no witnessed range, no part";
   s.intervals[0].witnessed_lower = 0.0;  // [-1, 0) unwitnessed: 25 % of the width 4
   s.intervals[0].witnessed_upper = 2.5;  // (2.5, 3] unwitnessed: 12.5 %
@@ -127,19 +129,19 @@ TEST(LargestUnwitnessedPart, TheWidestSideNoCertifiedPointReaches) {
 }
 
 TEST(ProvenBox, OnlyVerifiedEndpointsShrinkTheBox) {
-  BoundsSummary s = Piece(-0.5, 0.25, "solved");
+  BoundsSummary s = Piece(-0.5, 0.25, OrthantStatus::kSolved);
   EXPECT_EQ(ProvenBox(s, kBox), (ParameterBox{{-0.5, 0.25}, {0, 4}, {-2, 2}}));  // q, r: not computed, kept
-  s.intervals[0].upper.verification = "unverified";  // a floating-point bound proves nothing
+  s.intervals[0].upper.verification = sdp::VerifyStatus::kUnverified;  // a floating-point bound proves nothing
   EXPECT_EQ(ProvenBox(s, kBox), (ParameterBox{{-0.5, 1}, {0, 4}, {-2, 2}}));
-  s.intervals[0].lower.verification = "off";
+  s.intervals[0].lower.verification = sdp::VerifyStatus::kNotRun;
   EXPECT_EQ(ProvenBox(s, kBox), kBox);
-  const BoundsSummary point = Piece(0.5, 0.5, "solved");  // no box side of width 0
+  const BoundsSummary point = Piece(0.5, 0.5, OrthantStatus::kSolved);  // no box side of width 0
   EXPECT_EQ(ProvenBox(point, kBox), kBox);
-  EXPECT_EQ(ProvenBox(Piece(0, 0, "empty (LP)"), kBox), kBox);
+  EXPECT_EQ(ProvenBox(Piece(0, 0, OrthantStatus::kEmpty), kBox), kBox);
 }
 
 TEST(AutoSplit, TheCutLiesBeyondTheWitnessAndEarlierCutsOutsideTheBoxGo) {
-  BoundsSummary s = Piece(-1.0, 3.0, "solved");
+  BoundsSummary s = Piece(-1.0, 3.0, OrthantStatus::kSolved);
   s.intervals[0].witnessed_lower = 0.0;
   s.intervals[0].witnessed_upper = 1.0;
   const auto part = LargestUnwitnessedPart(s);  // (1, 3]

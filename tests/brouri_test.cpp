@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "estimators/brouri/workflow.hpp"
 
 namespace hw::brouri {

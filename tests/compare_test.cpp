@@ -13,7 +13,7 @@
 #include "compare/methods.hpp"
 #include "compare/study.hpp"
 #include "core/cerone_example.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 
 namespace hw::compare {
 namespace {

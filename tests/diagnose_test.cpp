@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/effects.hpp"
 #include "diagnose/locate.hpp"

@@ -44,7 +44,7 @@ TEST(EdgeWitness, SettledEndpointsEqualTheRelaxationsAndContainTheTruth) {
   ASSERT_GT(with.edge_witness_settled, 0) << "the instance no longer exercises the stage";
   EXPECT_LT(with.sdp_jobs, without.sdp_jobs);
   EXPECT_EQ(without.edge_witness_solves, 0);
-  EXPECT_GT(with.bound_sources.count("feasible point at the box edge"), 0u);
+  EXPECT_GT(with.bound_sources.count(BoundSource::kFeasiblePointAtEdge), 0u);
   CompareEndpoints(with, without, [&](const std::string& name, std::size_t k, const Endpoint& x, const Endpoint& y,
                                       bool lower) {
     // An endpoint at the box edge is the relaxation's bound too (the SDP reaches it up to its accuracy).

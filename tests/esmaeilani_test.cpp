@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/csv_table.hpp"
 #include "core/hw_model.hpp"
+#include "core/input_error.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 #include "estimators/esmaeilani/valve_case.hpp"
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "dss/hw_outer_set.hpp"
 
 namespace hw::dss {

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "compare/scenario.hpp"
-#include "core/csv_table.hpp"
 #include "core/hw_model.hpp"
+#include "core/input_error.hpp"
 #include "estimators/brouri/experiment.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 #include "pop/pop_json.hpp"

@@ -16,7 +16,7 @@ namespace {
 
 TEST(MomentWitness, FirstMomentsSurviveTheRunCache) {
   JobOutcome o;
-  o.status = "solved";
+  o.status = JobStatus::kSolved;
   o.first_moments = {0.25, -1.5, 3.0};
   EXPECT_EQ(JobOutcome::from_json(o.to_json()).first_moments, o.first_moments);
   auto older = o.to_json();  // a job cached before the field existed

@@ -10,7 +10,8 @@
 
 #include "compare/scenario.hpp"
 #include "compare/study.hpp"
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
+#include "core/input_error.hpp"
 #include "core/output_files.hpp"
 
 namespace hw {

@@ -4,7 +4,6 @@
 
 #include <string>
 
-#include "core/csv_table.hpp"
 #include "core/polynomial.hpp"
 #include "pop/pop_json.hpp"
 #include "tests/test_support.hpp"

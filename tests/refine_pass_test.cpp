@@ -14,7 +14,7 @@ namespace {
 
 JobOutcome Solved(double bound, bool unfinished) {
   JobOutcome r;
-  r.status = "solved";
+  r.status = JobStatus::kSolved;
   r.bound = bound;
   r.unfinished = unfinished;
   return r;
@@ -49,8 +49,8 @@ int ExpectInsideWithTheTruthAndVerified(const BoundsSummary& plain, const Bounds
     EXPECT_LE(b.upper.value, a.upper.value) << b.name;
     EXPECT_LE(b.lower.value, truth[k] + 1e-6) << b.name;
     EXPECT_GE(b.upper.value, truth[k] - 1e-6) << b.name;
-    EXPECT_EQ(b.lower.verification, "verified") << b.name;
-    EXPECT_EQ(b.upper.verification, "verified") << b.name;
+    EXPECT_EQ(b.lower.verification, sdp::VerifyStatus::kVerified) << b.name;
+    EXPECT_EQ(b.upper.verification, sdp::VerifyStatus::kVerified) << b.name;
     narrower += (b.upper.value - b.lower.value < a.upper.value - a.lower.value - 1e-9);
   }
   return narrower;
@@ -60,7 +60,7 @@ TEST(RefinePass, OnlyStoppedShortBoundsThatAreTheEndpointQualify) {
   const std::vector<Objective> objectives{{0, -1}, {0, +1}, {1, -1}};
   std::vector<OrthantWork> orthants(4);
   for (int l = 0; l < 4; ++l) orthants[l].index = l;
-  orthants[3].status = "empty (LP)";
+  orthants[3].ProveEmpty({CertificateKind::kLinearProgram, 0, false, true});
   PassOutcomes full;
   // min x0: orthant 0 stopped short at -2 (the endpoint); orthant 1 stopped short at -1 (orthant 0 lies beyond).
   full[{0, 0}] = Solved(-2.0, true);
@@ -89,7 +89,7 @@ TEST(RefinePass, OpenEndpointsAreTheSolvedEndpointsNoWitnessReaches) {
   const std::vector<Objective> objectives{{0, -1}, {0, +1}, {1, -1}, {1, +1}};
   std::vector<OrthantWork> orthants(3);
   for (int l = 0; l < 3; ++l) orthants[l].index = l;
-  orthants[2].status = "empty (LP)";
+  orthants[2].ProveEmpty({CertificateKind::kLinearProgram, 0, false, true});
   PassOutcomes full;
   full[{0, 0}] = Solved(-2.0, false);  // min x0: the endpoint, finished, a witness at -1.5: open
   full[{1, 0}] = Solved(-1.0, true);   // orthant 0 lies beyond
@@ -105,7 +105,7 @@ TEST(RefinePass, OpenEndpointsAreTheSolvedEndpointsNoWitnessReaches) {
   const std::vector<std::pair<int, int>> expected{{0, 0}, {1, 3}};
   EXPECT_EQ(targets, expected);
   // Without witnesses every solved endpoint is open; a skipped outcome (settled at the box edge) never is.
-  full[{0, 1}].status = "skipped";
+  full[{0, 1}].status = JobStatus::kSkipped;
   const std::vector<std::pair<int, int>> without{{0, 0}, {1, 3}};
   EXPECT_EQ(OpenEndpoints(objectives, {0, 1, 3}, full, orthants, {}), without);
 }

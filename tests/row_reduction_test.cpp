@@ -13,6 +13,7 @@
 #include "dss/basis.hpp"
 #include "dss/bound_jobs.hpp"
 #include "dss/hw_outer_set.hpp"
+#include "dss/job_function.hpp"
 #include "dss/row_reduction.hpp"
 #include "dss/set_membership.hpp"
 #include "pop/constraint_generation.hpp"

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "sdp/job_pool.hpp"
 #include "sdp/lmi_problem.hpp"
 #include "sdp/sdp_solver.hpp"

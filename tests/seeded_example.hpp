@@ -36,8 +36,8 @@ void CompareEndpoints(const BoundsSummary& with, const BoundsSummary& without, c
     const auto& b = without.intervals[i];
     const std::size_t k = ParameterIndex(with, a.name);
     for (const auto& [x, y, lower] : {std::tuple{a.lower, b.lower, true}, std::tuple{a.upper, b.upper, false}}) {
-      EXPECT_EQ(x.status, "guaranteed") << a.name << (lower ? " lower" : " upper");
-      EXPECT_EQ(x.verification, "verified") << a.name << (lower ? " lower" : " upper");
+      EXPECT_EQ(x.status, EndpointStatus::kGuaranteed) << a.name << (lower ? " lower" : " upper");
+      EXPECT_EQ(x.verification, sdp::VerifyStatus::kVerified) << a.name << (lower ? " lower" : " upper");
       check(a.name, k, x, y, lower);
     }
     EXPECT_LE(a.lower.value, truth[k]) << a.name;

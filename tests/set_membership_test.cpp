@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "dss/set_membership.hpp"
 
 namespace hw::dss {
@@ -34,7 +34,7 @@ void ExpectCoverage(const BoundsSummary& s, const std::string& label) {
   for (const auto& iv : s.intervals) {
     const std::size_t k = std::find(s.parameter_names.begin(), s.parameter_names.end(), iv.name) - s.parameter_names.begin();
     ASSERT_LT(k, truth.size());
-    EXPECT_NE(iv.lower.status, "empty") << label;
+    EXPECT_NE(iv.lower.status, EndpointStatus::kEmpty) << label;
     EXPECT_LE(iv.lower.value, truth[k] + 1e-6) << label << " " << iv.name;
     EXPECT_GE(iv.upper.value, truth[k] - 1e-6) << label << " " << iv.name;
   }
@@ -66,7 +66,7 @@ TEST(SetMembership, Horizon2Order2TinyNoiseGivesANarrowIntervalAroundTheTruth) {
   // Narrowness is only meaningful for solved endpoints: a failed solve is widened to the box (valid, but not
   // comparable). Such a run is reported as skipped, with the solver's notes, never as passed.
   const auto& iv = clean.intervals[0];
-  if (iv.lower.status != "guaranteed" || iv.upper.status != "guaranteed")
+  if (iv.lower.status != EndpointStatus::kGuaranteed || iv.upper.status != EndpointStatus::kGuaranteed)
     GTEST_SKIP() << "a solve failed and fell back to a conservative bound; width not checked. notes: " << iv.lower.note
                  << " | " << iv.upper.note;
   EXPECT_LT(iv.half_width(), 0.05 * 1.8) << "a1 at 80 dB: [" << iv.lower.value << ", " << iv.upper.value << "]";

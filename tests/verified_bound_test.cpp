@@ -305,8 +305,9 @@ TEST(VerifiedBound, EverySetMembershipEndpointCarriesItsVerification) {
   ASSERT_FALSE(s.intervals.empty());
   for (const auto& iv : s.intervals) {
     for (const auto* e : {&iv.lower, &iv.upper}) {
-      if (e->status == "empty") continue;
-      EXPECT_TRUE(e->verification == "verified" || e->verification == "unverified") << iv.name << " " << e->verification;
+      if (e->status == dss::EndpointStatus::kEmpty) continue;
+      EXPECT_TRUE(e->verification == sdp::VerifyStatus::kVerified || e->verification == sdp::VerifyStatus::kUnverified)
+          << iv.name << " " << e->verification;
       EXPECT_GE(e->correction, 0.0) << iv.name;
     }
     const std::size_t k = std::find(s.parameter_names.begin(), s.parameter_names.end(), iv.name) - s.parameter_names.begin();

@@ -125,10 +125,10 @@ TEST(WitnessStop, AnOrthantWhoseSignBoundIsBeyondAWitnessedValueIsSettledWithout
   w.box = set.box();
   const auto settled = SettleBySignBeyondWitness(set, w, {alpha2, -1}, -1.0);
   ASSERT_TRUE(settled.has_value());
-  EXPECT_EQ(settled->status, "skipped");
-  EXPECT_EQ(settled->origin, "orthant sign constraint");
+  EXPECT_EQ(settled->status, JobStatus::kSkipped);
+  EXPECT_EQ(settled->origin, JobOrigin::kSignConstraint);
   EXPECT_EQ(settled->bound, 0.0);
-  EXPECT_EQ(settled->verification, "verified");
+  EXPECT_EQ(settled->verification, sdp::VerifyStatus::kVerified);
   EXPECT_EQ(SettleBySignBeyondWitness(set, w, {alpha2, -1}, 0.0)->bound, 0.0);  // at the value: cannot move it
   EXPECT_FALSE(SettleBySignBeyondWitness(set, w, {alpha2, -1}, 0.3));  // the orthant may hold alpha2 < 0.3
   EXPECT_FALSE(SettleBySignBeyondWitness(set, w, {alpha2, -1}, NAN));

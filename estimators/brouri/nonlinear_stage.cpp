@@ -6,7 +6,7 @@
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/json_input.hpp"
 #include "estimators/brouri/outliers.hpp"
 

@@ -9,7 +9,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 #include <unsupported/Eigen/Polynomials>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/json_input.hpp"
 
 namespace hw::brouri {

@@ -13,7 +13,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 
 namespace hw::brouri {
 

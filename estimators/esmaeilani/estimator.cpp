@@ -10,7 +10,7 @@
 #include <Eigen/SparseCore>
 #include <fmt/format.h>
 
-#include "core/csv_table.hpp"
+#include "core/input_error.hpp"
 #include "core/json_input.hpp"
 
 namespace hw::esmaeilani {

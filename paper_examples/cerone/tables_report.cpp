@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "core/csv_table.hpp"
+#include "core/atomic_write.hpp"
 #include "core/output_files.hpp"
 #include "paper_examples/cerone/paper_table.hpp"
 
@@ -54,7 +54,8 @@ std::string MarkdownRow(const TableCase& c, const InnerInterval& inner, const st
       row += " not run | – | – | – |";
       continue;
     }
-    const bool sure = outer->lower.status == "guaranteed" && outer->upper.status == "guaranteed";
+    const bool sure = outer->lower.status == dss::EndpointStatus::kGuaranteed &&
+                      outer->upper.status == dss::EndpointStatus::kGuaranteed;
     row += fmt::format(" {}{} | {} | {} | {} |", Interval(outer->lower.value, outer->upper.value), sure ? "" : " *",
                        Number(outer->half_width()), Number(outer->half_width() / inner_half, "{:.2f}"),
                        Number(outer->half_width() / paper_half, "{:.2f}"));
