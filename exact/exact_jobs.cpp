@@ -6,6 +6,21 @@
 #include <fmt/format.h>
 
 namespace hw::exact {
+namespace {
+
+// The two kinds of job, as the spec's "kind" names them.
+enum class JobKind { kEmptiness, kObjective };
+constexpr const char* kEmptinessKind = "empty";
+constexpr const char* kObjectiveKind = "objective";
+
+JobKind KindOf(const nlohmann::json& spec) {
+  const std::string kind = spec.at("kind").get<std::string>();
+  if (kind == kEmptinessKind) return JobKind::kEmptiness;
+  if (kind == kObjectiveKind) return JobKind::kObjective;
+  throw std::invalid_argument("exact job: unknown kind '" + kind + "'");
+}
+
+}  // namespace
 
 std::string EncodeBasis(const LpBasis& basis) {
   static const char* hex = "0123456789abcdef";
@@ -38,14 +53,14 @@ std::string JobKey(const std::string& spec) {
 }
 
 nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool cheap_windows) {
-  return {{"kind", "empty"}, {"box", BoxToJson(box)}, {"warm", EncodeBasis(warm)}, {"cheap", cheap_windows}};
+  return {{"kind", kEmptinessKind}, {"box", BoxToJson(box)}, {"warm", EncodeBasis(warm)}, {"cheap", cheap_windows}};
 }
 
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& b : boxes) list.push_back(BoxToJson(b));
-  nlohmann::json j = {{"kind", "objective"}, {"start", BoxToJson(start)}, {"boxes", list},
+  nlohmann::json j = {{"kind", kObjectiveKind}, {"start", BoxToJson(start)}, {"boxes", list},
                       {"parameter", objective.parameter}, {"maximise", objective.maximise}, {"target_gap", target_gap}};
   j["target"] = target ? nlohmann::json(*target) : nlohmann::json(nullptr);
   return j;
@@ -66,7 +81,7 @@ sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSett
   return [&data, settings](const std::string& text) {
     const nlohmann::json spec = nlohmann::json::parse(text);
     auto solver = MakeLpSolver(settings.lp_solver);
-    if (spec.at("kind") == "empty") {
+    if (KindOf(spec) == JobKind::kEmptiness) {
       BoxEvaluationOptions evaluation = settings.evaluation;
       if (!spec.at("cheap").get<bool>()) evaluation.cheap_windows = 0;
       const BoxEvaluation e = TestBoxEmpty(data, BoxFromJson(spec.at("box")), evaluation, *solver,
