@@ -27,7 +27,7 @@ const std::vector<EffectInfo>& Infos() {
       {Effect::kSaturation, "saturation", {"lower", "upper"}},
       {Effect::kRateLimit, "rate_limit", {"max_step"}},
       {Effect::kDelay, "delay", {"samples"}},
-      {Effect::kQuantization, "quantization", {"step"}},
+      {Effect::kQuantization, "quantization", {"step", "offset"}},
       {Effect::kCoulombFriction, "coulomb_friction", {"level_up", "level_down"}},
       {Effect::kHysteresis, "hysteresis", {"threshold", "height"}},
       {Effect::kCubicStiffness, "cubic_stiffness", {"k3"}},
@@ -226,7 +226,7 @@ bool EffectBlock::IsValid(std::string* error) const {
       if (params[0] < 1 || params[0] != std::round(params[0])) return fail("delay: samples must be an integer >= 1");
       break;
     case Effect::kQuantization:
-      if (!(params[0] > 0)) return fail("quantization: step must be > 0");
+      if (!(params[0] > 0) || !std::isfinite(params[1])) return fail("quantization: step must be > 0 and offset finite");
       break;
     case Effect::kSaturation:
     case Effect::kStateSaturation:
@@ -276,6 +276,10 @@ EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
     RequireKnownKeys(ps, std::set<std::string>(names.begin(), names.end()),
                      fmt::format("effect block {} parameters", EffectName(b.effect)));
     for (const auto& n : names) {
+      if (b.effect == Effect::kQuantization && std::string(n) == "offset" && !ps.contains(n)) {
+        b.params.push_back(0.0);  // models written before the grid offset existed
+        continue;
+      }
       const auto& v = ps.at(n);
       if (v.is_string()) {
         const auto s = v.get<std::string>();
@@ -300,8 +304,11 @@ double ApplyStaticBlock(const EffectBlock& block, double v) {
       return Sign(v) * std::max(std::abs(v) - block.params[0], 0.0);
     case Effect::kSaturation:
       return std::clamp(v, block.params[0], block.params[1]);
-    case Effect::kQuantization:
-      return block.params[0] * std::round(v / block.params[0]);
+    case Effect::kQuantization: {
+      // Levels offset + k step: the grid of a quantizer need not pass through the recording's 0.
+      const double o = block.params.size() > 1 ? block.params[1] : 0.0;
+      return o + block.params[0] * std::round((v - o) / block.params[0]);
+    }
     default:
       return v;
   }

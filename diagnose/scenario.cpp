@@ -136,7 +136,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
         case Effect::kDelay:
           return {o.effect, loc, {double(k_delay)}};
         case Effect::kQuantization:
-          return {o.effect, loc, {std::max(1e-6, s * 0.5 * range)}};
+          return {o.effect, loc, {std::max(1e-6, s * 0.5 * range), 0.0}};
         case Effect::kHysteresis:
           return {o.effect, loc, {beta, s * 0.5 * StdDev(u_id)}};
         case Effect::kStiction:

@@ -53,7 +53,7 @@ py::object Diagnose(py::handle ident_arg, py::handle valid_arg, py::handle model
   } else {
     const auto spec = diagnose::NominalSpec::Parse(fit.cast<std::string>());
     WithoutGil([&] {
-      const diagnose::NominalFit nominal = diagnose::FitNominal(spec, {&ident.u, &ident.y, o.init_samples, 0}, o.nominal_fit);
+      const diagnose::NominalFit nominal = diagnose::FitNominalForDiagnosis(spec, ident, o);
       diagnose::Diagnose(o, nominal.model, &spec, ident, valid, &report);
       return 0;
     });
