@@ -141,7 +141,7 @@ struct Reference {
 bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t skip) {
   if (b.effect != Effect::kDeadzone) return true;
   Vec mag;
-  for (std::size_t t = skip; t < signal.size(); ++t) mag.push_back(std::abs(signal[t]));
+  for (std::size_t t = skip; t < signal.size(); ++t) mag.push_back(std::abs(signal[t] - b.params[1]));
   return b.params[0] < Median(mag);
 }
 
@@ -524,8 +524,8 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
   if (verdict && explained >= 0.5) {
     r->nominal_status = NominalStatus::kExplainedByEffect;
     r->nominal_status_note = fmt::format("the nominal alone stays above the noise floor (held-out RMSE {:.4g} = {:.2f} x the "
-                                         "noise {:.4g}); {} explains {:.0f} % of the excess mean square",
-                                         r->baseline_holdout_rmse, r->baseline_holdout_rmse / sigma, sigma, verdict->Label(),
+                                         "noise {:.4g}); the verdict explains {:.0f} % of the excess mean square",
+                                         r->baseline_holdout_rmse, r->baseline_holdout_rmse / sigma, sigma,
                                          100 * std::min(explained, 1.0));
     return verdict;
   }
@@ -557,7 +557,7 @@ OperatingPoint OperatingPoint::Of(const Recording& ident) {
   auto far = [](const Vec& v, double* centre) {
     const double lo = Quantile(v, 0.01), hi = Quantile(v, 0.99);
     *centre = Median(v);
-    return (lo > 0 || hi < 0) && std::abs(*centre) > 0.5 * (hi - lo);
+    return (lo > 0 || hi < 0) && std::abs(*centre) > 2.0 * (hi - lo);
   };
   OperatingPoint op;
   double cu = 0.0, cy = 0.0;
@@ -596,10 +596,22 @@ FeedbackTest DetectFeedback(const Vec& u, const Vec& e, std::size_t skip, int la
   }
   Eigen::MatrixXd own(rows, lags + 1);
   own << full.leftCols(lags), full.rightCols(1);
-  const double rss1 = (target - full * full.colPivHouseholderQr().solve(target)).squaredNorm();
-  const double rss0 = (target - own * own.colPivHouseholderQr().solve(target)).squaredNorm();
-  const double dof = static_cast<double>(rows) - (2 * lags + 1);
-  if (!(rss1 > 0) || dof < 1) return f;
+  // Steps and PRBS switches are large innovations of u that no past explains; they would drown the
+  // feedback part. The 10 % largest innovations of u's own model are left out of both regressions.
+  const Eigen::VectorXd innov = target - own * own.colPivHouseholderQr().solve(target);
+  if (innov.squaredNorm() <= 1e-20 * target.squaredNorm()) return f;  // u is its own past: nothing enters
+  std::vector<double> mag(innov.data(), innov.data() + rows);
+  for (auto& v : mag) v = std::abs(v);
+  const double cut = Quantile(mag, 0.9);
+  std::vector<Eigen::Index> keep;
+  for (std::size_t i = 0; i < rows; ++i)
+    if (std::abs(innov(i)) <= cut) keep.push_back(static_cast<Eigen::Index>(i));
+  const Eigen::MatrixXd fk = full(keep, Eigen::all), ok = own(keep, Eigen::all);
+  const Eigen::VectorXd tk = target(keep);
+  const double rss1 = (tk - fk * fk.colPivHouseholderQr().solve(tk)).squaredNorm();
+  const double rss0 = (tk - ok * ok.colPivHouseholderQr().solve(tk)).squaredNorm();
+  const double dof = static_cast<double>(keep.size()) - (2 * lags + 1);
+  if (!(rss1 > 1e-20 * tk.squaredNorm()) || dof < 1) return f;
   f.statistic = (rss0 - rss1) / (rss1 / dof);
   f.threshold = ChiSquareQuantile(0.999, lags);
   f.detected = f.statistic > f.threshold;

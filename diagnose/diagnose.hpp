@@ -53,7 +53,7 @@ struct OperatingPoint {
   bool u_removed = false, y_removed = false;
   double u = 0.0, y = 0.0;
   // Far from 0: the signal stays on one side of 0 (1 % and 99 % quantiles) and its median is more than
-  // half its 1-99 % spread away from 0.
+  // twice its 1-99 % spread away from 0 (a tank level between 1 and 10 V is not: its 0 is physical).
   static OperatingPoint Of(const Recording& ident);
   Recording Centred(const Recording& r) const;
   nlohmann::json to_json() const;

@@ -23,7 +23,7 @@ struct EffectInfo {
 const std::vector<EffectInfo>& Infos() {
   static const std::vector<EffectInfo> infos = {
       {Effect::kBacklash, "backlash", {"half_width"}},
-      {Effect::kDeadzone, "deadzone", {"half_width"}},
+      {Effect::kDeadzone, "deadzone", {"half_width", "centre"}},
       {Effect::kSaturation, "saturation", {"lower", "upper"}},
       {Effect::kRateLimit, "rate_limit", {"max_step"}},
       {Effect::kDelay, "delay", {"samples"}},
@@ -216,8 +216,10 @@ bool EffectBlock::IsValid(std::string* error) const {
   const std::string n = EffectName(effect);
   switch (effect) {
     case Effect::kBacklash:
-    case Effect::kDeadzone:
       if (params[0] < 0) return fail(n + ": half_width must be >= 0");
+      break;
+    case Effect::kDeadzone:
+      if (params[0] < 0 || !std::isfinite(params[1])) return fail(n + ": half_width must be >= 0 and centre finite");
       break;
     case Effect::kRateLimit:
       if (!(params[0] > 0)) return fail("rate_limit: max_step must be > 0");
@@ -276,8 +278,10 @@ EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
     RequireKnownKeys(ps, std::set<std::string>(names.begin(), names.end()),
                      fmt::format("effect block {} parameters", EffectName(b.effect)));
     for (const auto& n : names) {
-      if (b.effect == Effect::kQuantization && std::string(n) == "offset" && !ps.contains(n)) {
-        b.params.push_back(0.0);  // models written before the grid offset existed
+      if (((b.effect == Effect::kQuantization && std::string(n) == "offset") ||
+           (b.effect == Effect::kDeadzone && std::string(n) == "centre")) &&
+          !ps.contains(n)) {
+        b.params.push_back(0.0);  // models written before the grid offset and the band's centre existed
         continue;
       }
       const auto& v = ps.at(n);
@@ -300,8 +304,11 @@ EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
 
 double ApplyStaticBlock(const EffectBlock& block, double v) {
   switch (block.effect) {
-    case Effect::kDeadzone:
-      return Sign(v) * std::max(std::abs(v) - block.params[0], 0.0);
+    case Effect::kDeadzone: {
+      // A dead band of half-width d around c (0 unless the band sits at an operating point).
+      const double c = block.params.size() > 1 ? block.params[1] : 0.0;
+      return c + Sign(v - c) * std::max(std::abs(v - c) - block.params[0], 0.0);
+    }
     case Effect::kSaturation:
       return std::clamp(v, block.params[0], block.params[1]);
     case Effect::kQuantization: {

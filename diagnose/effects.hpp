@@ -13,7 +13,7 @@
 //
 // Effect blocks (parameters in the order of EffectBlock::params, physical ranges in brackets):
 //   backlash@input        [w >= 0]      play operator of half-width w: x_t = clamp(x_{t-1}, u_t - w, u_t + w)
-//   deadzone@input|output [d >= 0]      v -> sign(v) max(|v| - d, 0)
+//   deadzone@input|output [d >= 0, c]   v -> c + sign(v - c) max(|v - c| - d, 0)  (band around c; c optional in JSON, 0)
 //   saturation@input|output [lo < hi]   v -> clamp(v, lo, hi) (either limit may be infinite)
 //   rate_limit@input      [r > 0]       x_t = x_{t-1} + clamp(u_t - x_{t-1}, -r, r)
 //   delay@input           [k >= 1]      dead time: x_t = u_{t-k}, extra to the model's delay (integer)

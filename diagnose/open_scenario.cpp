@@ -163,7 +163,7 @@ struct EffectShape {
       case Effect::kBacklash:
         return {effect, location, {s * 0.3 * range}};
       case Effect::kDeadzone:
-        return {effect, location, {s * 0.6 * vmax}};
+        return {effect, location, {s * 0.6 * vmax, 0.0}};
       case Effect::kSaturation:
       case Effect::kStateSaturation: {
         const double q = std::max(1e-4, 0.4 * s);
@@ -381,8 +381,8 @@ OpenScenario DrawOpenScenario(const OpenScenarioOptions& o, Rng& rng) {
   // Operating point: recorded values around u0, y0 far from 0.
   if (Uniform(rng, 0, 1) < o.offset_probability) {
     const double su = StdDev(sc.ident.u), sy = StdDev(sc.ident.y);
-    sc.u_offset = (Uniform(rng, 0, 1) < 0.5 ? -1 : 1) * Uniform(rng, 3, 20) * su;
-    sc.y_offset = (Uniform(rng, 0, 1) < 0.5 ? -1 : 1) * Uniform(rng, 3, 20) * sy;
+    sc.u_offset = (Uniform(rng, 0, 1) < 0.5 ? -1 : 1) * Uniform(rng, 12, 40) * su;
+    sc.y_offset = (Uniform(rng, 0, 1) < 0.5 ? -1 : 1) * Uniform(rng, 12, 40) * sy;
     for (auto* rec : {&sc.ident, &sc.valid}) {
       for (auto& v : rec->u) v += sc.u_offset;
       for (auto& v : rec->y) v += sc.y_offset;

@@ -14,7 +14,7 @@
 //                 divided by a ratio drawn in [0.5, 3] (the effect is 0.5-3 noise standard deviations
 //                 strong where it can be seen at all);
 //   record length 600-1400 samples per recording;
-//   offsets       in 40 % of the scenarios u and y are recorded around an operating point 3-20 of their
+//   offsets       in 40 % of the scenarios u and y are recorded around an operating point 12-40 of their
 //                 standard deviations away from 0 (the effects act on the deviations).
 // The seed alone fixes the scenario; the effect row is chosen by the caller.
 #include <string>

@@ -250,8 +250,9 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
         for (double r : {0.0, 0.3, 0.6, 0.9}) g.push_back({fs, r * fs});
       break;
     case Effect::kDeadzone: {
-      // Around the signal's own zero: deadzones act on the signal's magnitude.
-      for (double d : LogSpace(2e-3 * vmax, 0.6 * vmax, 36)) g.push_back({d});
+      // Around the signal's own zero, or near it (a band at an operating point; LM refines the centre).
+      for (double d : LogSpace(2e-3 * vmax, 0.6 * vmax, 36))
+        for (double c : {0.0, -0.1, 0.1, -0.25, 0.25}) g.push_back({d, c * vmax});
       break;
     }
     case Effect::kSaturation:

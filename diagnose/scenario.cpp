@@ -124,7 +124,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
         case Effect::kBacklash:
           return {o.effect, loc, {s * 0.3 * range}};
         case Effect::kDeadzone:
-          return {o.effect, loc, {s * 0.6 * vmax}};
+          return {o.effect, loc, {s * 0.6 * vmax, 0.0}};
         case Effect::kSaturation:
         case Effect::kStateSaturation: {
           const double q = std::max(1e-4, 0.35 * s);
