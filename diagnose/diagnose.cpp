@@ -138,11 +138,15 @@ struct Reference {
 // A block whose parameters describe no physical device: a dead band so wide that the signal spends
 // most of the time inside it (half-width >= the median of |v|), e.g. a band that reaches from 0 to an
 // operating point.
+// A band must also sit inside the signal's central range (within a quarter of its 5-95 % spread of the
+// median): a "dead band" at the edge of the data is a clamp, and saturation is the block for that.
 bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t skip) {
   if (b.effect != Effect::kDeadzone) return true;
+  const Vec v(signal.begin() + std::min(skip, signal.size()), signal.end());
   Vec mag;
-  for (std::size_t t = skip; t < signal.size(); ++t) mag.push_back(std::abs(signal[t] - b.params[1]));
-  return b.params[0] < Median(mag);
+  for (double x : v) mag.push_back(std::abs(x - b.params[1]));
+  const double spread = Quantile(v, 0.95) - Quantile(v, 0.05);
+  return b.params[0] < Median(mag) && std::abs(b.params[1] - Median(v)) <= 0.25 * spread;
 }
 
 Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
@@ -307,7 +311,8 @@ std::vector<Finding> SearchPairs(const Context& c, const Finding& single, const 
   for (const auto& f : ranked) {
     if (static_cast<int>(partners.size()) >= c.o.pair_partners) break;
     const auto& b = f.blocks.front();
-    if (f.holdout.score <= 0 || (b.effect == single.blocks[0].effect && b.location == single.blocks[0].location))
+    if (f.holdout.score <= 0 || !f.meaningful ||
+        (b.effect == single.blocks[0].effect && b.location == single.blocks[0].location))
       continue;
     partners.emplace_back(b.effect, b.location);
   }
