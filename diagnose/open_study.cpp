@@ -138,6 +138,11 @@ std::string OpenStudyResult::to_markdown(const std::string& command, bool verbos
                    NullReachesNoise(NominalMode::kGiven).Text(), NullReachesNoise(NominalMode::kFitted).Text());
   s += fmt::format("Of the null cases above it, reported as a failed fit: given {}, fitted {}.\n\n",
                    NullFailReported(NominalMode::kGiven).Text(), NullFailReported(NominalMode::kFitted).Text());
+  if (!skipped_seeds.empty()) {
+    s += "Seeds without a usable scenario (the system diverged or the effect was invisible after 8 draws):";
+    for (unsigned v : skipped_seeds) s += fmt::format(" {}", v);
+    s += "\n\n";
+  }
   s += "Misses (row, mode, seed, input, structure, ratio, verdict):\n\n";
   for (const auto& c : cases)
     if (!c.named_right)
@@ -166,11 +171,27 @@ OpenStudyResult RunOpenStudy(const OpenStudyOptions& o) {
     so.effect = plan[i].first;
     so.location = plan[i].second;
     so.seed = o.first_seed + static_cast<unsigned>(i);
-    const OpenScenario sc = MakeOpenScenario(so);
+    OpenScenario sc;
+    try {
+      sc = MakeOpenScenario(so);
+    } catch (const InputError& e) {  // no usable draw for this seed: reported, not silently skipped
+      fmt::print(stderr, "seed {}: {}\n", so.seed, e.what());
+      res.skipped_seeds.push_back(so.seed);
+      continue;
+    }
     for (NominalMode m : o.modes) {
-      OpenCase c = RunOne(o, sc, RowName(plan[i].first, plan[i].second), m);
+      OpenCase c;
+      try {
+        c = RunOne(o, sc, RowName(plan[i].first, plan[i].second), m);
+      } catch (const InputError& e) {  // counted as a miss, with the reason
+        c.row = RowName(plan[i].first, plan[i].second);
+        c.mode = m;
+        c.verdict = std::string("error: ") + e.what();
+        c.named_right = false;
+      }
       c.seed = so.seed;
       res.cases.push_back(c);
+      if (o.progress) fmt::print(stderr, "{} {} seed {}: {} ({:.1f} s)\n", c.row, NominalModeName(m), c.seed, c.verdict, c.seconds);
     }
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

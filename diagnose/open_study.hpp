@@ -24,6 +24,7 @@ struct OpenStudyOptions {
   unsigned first_seed = 1;    // scenario i uses seed first_seed + i
   std::vector<NominalMode> modes = {NominalMode::kGiven, NominalMode::kFitted};
   OpenScenarioOptions scenario;  // effect, location and seed are set per scenario
+  bool progress = false;         // one line per diagnosis on stderr
   DiagnoseOptions diagnose;
   bool IsValid(std::string* error) const;
 };
@@ -56,6 +57,7 @@ struct Proportion {
 struct OpenStudyResult {
   std::vector<OpenCase> cases;
   std::vector<std::string> rows;
+  std::vector<unsigned> skipped_seeds;  // no usable scenario for the seed (said in the report)
   double seconds = 0.0;
   Proportion PerRow(const std::string& row, NominalMode mode) const;
   Proportion NullReachesNoise(NominalMode mode) const;  // null cases whose baseline held-out RMSE <= 1.2 x noise

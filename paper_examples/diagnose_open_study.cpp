@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
     if (modes.find("fitted") != std::string::npos) o.modes.push_back(NominalMode::kFitted);
     if (o.modes.empty()) throw hw::InputError("MODES must name given and/or fitted");
     o.diagnose.threads = 1;
+    o.progress = true;
     std::string command = "build/paper_examples/diagnose_open_study";
     for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
     const OpenStudyResult res = RunOpenStudy(o);
