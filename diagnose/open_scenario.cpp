@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "diagnose/refit.hpp"
 #include "diagnose/signal_stats.hpp"
 
 namespace hw::diagnose {
@@ -19,18 +20,6 @@ using Rng = std::mt19937_64;
 double Uniform(Rng& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
 int UniformInt(Rng& rng, int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); }
 
-// Denominator coefficients a_1..a_n from the poles.
-Vec FromPoles(const std::vector<std::complex<double>>& poles) {
-  std::vector<std::complex<double>> c = {1.0};
-  for (const auto& p : poles) {
-    std::vector<std::complex<double>> n(c.size() + 1, 0.0);
-    for (std::size_t i = 0; i < c.size(); ++i) n[i] += c[i], n[i + 1] -= p * c[i];
-    c = n;
-  }
-  Vec a;
-  for (std::size_t i = 1; i < c.size(); ++i) a.push_back(c[i].real());
-  return a;
-}
 
 LinearBlock RandomLinear(Rng& rng) {
   const int na = UniformInt(rng, 1, 3);
@@ -41,7 +30,7 @@ LinearBlock RandomLinear(Rng& rng) {
   }
   while (static_cast<int>(poles.size()) < na) poles.emplace_back(Uniform(rng, 0.3, 0.97), 0.0);
   LinearBlock lb;
-  lb.a = FromPoles(poles);
+  lb.a = DenominatorFromRoots(poles);
   const int nb = UniformInt(rng, 1, 3);
   lb.b.resize(nb);
   lb.b[0] = 1.0;

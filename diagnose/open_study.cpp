@@ -1,5 +1,6 @@
 #include "diagnose/open_study.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -49,8 +50,8 @@ OpenCase RunOne(const OpenStudyOptions& o, const OpenScenario& sc, const std::st
 std::string NominalModeName(NominalMode m) { return m == NominalMode::kGiven ? "given" : "fitted"; }
 
 bool OpenStudyOptions::IsValid(std::string* error) const {
-  if (scenarios_per_row < 0 || null_scenarios < 0 || modes.empty()) {
-    if (error) *error = "open study: scenarios_per_row >= 0, null_scenarios >= 0 and at least one mode required";
+  if (scenarios_per_row < 0 || null_scenarios < 0 || modes.empty() || shards < 1 || shard < 0 || shard >= shards) {
+    if (error) *error = "open study: scenarios_per_row >= 0, null_scenarios >= 0, 0 <= shard < shards and at least one mode required";
     return false;
   }
   return scenario.IsValid(error) && diagnose.IsValid(error);
@@ -78,6 +79,46 @@ nlohmann::json OpenCase::to_json() const {
           {"ratio", ratio},       {"noise_std", noise_std}, {"nominal_holdout_rmse", nominal_holdout_rmse},
           {"input", input},       {"structure", structure}, {"offset", offset},
           {"feedback_detected", feedback_detected}, {"seconds", seconds}, {"best_candidate", best_candidate}};
+}
+
+OpenStudyResult OpenStudyResult::FromJson(const nlohmann::json& j) {
+  OpenStudyResult r;
+  try {
+    for (const auto& row : OpenStudyRows()) r.rows.push_back(RowName(row.first, row.second));
+    r.rows.push_back("none");
+    r.seconds = j.value("seconds", 0.0);
+    for (const auto& v : j.value("skipped_seeds", nlohmann::json::array())) r.skipped_seeds.push_back(v.get<unsigned>());
+    for (const auto& jc : j.value("cases", nlohmann::json::array())) {
+      OpenCase c;
+      c.row = jc.at("row").get<std::string>();
+      c.verdict = jc.at("verdict").get<std::string>();
+      c.mode = jc.at("mode").get<std::string>() == "given" ? NominalMode::kGiven : NominalMode::kFitted;
+      const std::string st = jc.at("status").get<std::string>();
+      for (NominalStatus s : {NominalStatus::kReachedNoiseFloor, NominalStatus::kExplainedByEffect, NominalStatus::kFailed})
+        if (NominalStatusName(s) == st) c.status = s;
+      c.named_right = jc.at("named_right").get<bool>();
+      c.seed = jc.at("seed").get<unsigned>();
+      c.ratio = jc.at("ratio").get<double>();
+      c.noise_std = jc.at("noise_std").get<double>();
+      c.nominal_holdout_rmse = jc.at("nominal_holdout_rmse").get<double>();
+      c.input = jc.at("input").get<std::string>();
+      c.structure = jc.at("structure").get<std::string>();
+      c.offset = jc.at("offset").get<bool>();
+      c.feedback_detected = jc.at("feedback_detected").get<bool>();
+      c.seconds = jc.at("seconds").get<double>();
+      c.best_candidate = jc.value("best_candidate", "");
+      r.cases.push_back(c);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("open study results: ") + e.what());
+  }
+  return r;
+}
+
+void OpenStudyResult::Merge(const OpenStudyResult& other) {
+  cases.insert(cases.end(), other.cases.begin(), other.cases.end());
+  skipped_seeds.insert(skipped_seeds.end(), other.skipped_seeds.begin(), other.skipped_seeds.end());
+  seconds += other.seconds;
 }
 
 std::vector<std::pair<Effect, Location>> OpenStudyRows() {
@@ -113,6 +154,7 @@ Proportion OpenStudyResult::NullFailReported(NominalMode mode) const {
 nlohmann::json OpenStudyResult::to_json() const {
   nlohmann::json j;
   j["seconds"] = seconds;
+  j["skipped_seeds"] = skipped_seeds;
   for (const auto& c : cases) j["cases"].push_back(c.to_json());
   for (NominalMode m : {NominalMode::kGiven, NominalMode::kFitted})
     for (const auto& row : rows) {
@@ -124,7 +166,7 @@ nlohmann::json OpenStudyResult::to_json() const {
 
 std::string OpenStudyResult::to_markdown(const std::string& command, bool verbose) const {
   std::string s = "# Open diagnosis study (second scenario generator)\n\n";
-  s += fmt::format("Command: `{}`\n\n{} diagnoses in {:.0f} s. Rate of verdicts that name the true effect at its "
+  s += fmt::format("Command: `{}`\n\n{} diagnoses in {:.0f} s (sum over processes). Rate of verdicts that name the true effect at its "
                    "location (for `none`: no false alarm), with Wilson 95 % intervals.\n\n",
                    command, cases.size(), seconds);
   s += "| row | nominal given | nominal fitted |\n|---|---|---|\n";
@@ -162,11 +204,18 @@ OpenStudyResult RunOpenStudy(const OpenStudyOptions& o) {
   const auto rows = o.rows.empty() ? OpenStudyRows() : o.rows;
   for (const auto& [e, l] : rows) res.rows.push_back(RowName(e, l));
   res.rows.push_back("none");
+  // Rounds of every effect row, the null scenarios spread over the rounds, so that a partial run
+  // holds every class in proportion.
   std::vector<std::pair<Effect, Location>> plan;
-  for (int s = 0; s < o.scenarios_per_row; ++s)
-    for (const auto& r : rows) plan.push_back(r);
-  for (int s = 0; s < o.null_scenarios; ++s) plan.emplace_back(Effect::kNone, Location::kInput);
+  const int rounds = std::max(o.scenarios_per_row, 1);
+  for (int s = 0; s < rounds; ++s) {
+    if (s < o.scenarios_per_row)
+      for (const auto& r : rows) plan.push_back(r);
+    for (int k = 0; k < o.null_scenarios; ++k)
+      if (k % rounds == s) plan.emplace_back(Effect::kNone, Location::kInput);
+  }
   for (std::size_t i = 0; i < plan.size(); ++i) {
+    if (static_cast<int>(i % o.shards) != o.shard) continue;
     OpenScenarioOptions so = o.scenario;
     so.effect = plan[i].first;
     so.location = plan[i].second;
@@ -193,6 +242,8 @@ OpenStudyResult RunOpenStudy(const OpenStudyOptions& o) {
       res.cases.push_back(c);
       if (o.progress) fmt::print(stderr, "{} {} seed {}: {} ({:.1f} s)\n", c.row, NominalModeName(m), c.seed, c.verdict, c.seconds);
     }
+    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.on_scenario) o.on_scenario(res);
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;

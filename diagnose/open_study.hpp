@@ -3,6 +3,7 @@
 // true nominal handed over (as --model) and once with the nominal's structure fitted by the tool
 // (as --fit), scored per effect class with Wilson 95 % intervals. Tuning and reporting use disjoint
 // seed ranges (the caller chooses first_seed).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct OpenStudyOptions {
   std::vector<NominalMode> modes = {NominalMode::kGiven, NominalMode::kFitted};
   OpenScenarioOptions scenario;  // effect, location and seed are set per scenario
   bool progress = false;         // one line per diagnosis on stderr
+  int shard = 0, shards = 1;     // run only scenarios i with i % shards == shard (seeds stay first_seed + i)
+  // Called after every scenario with the cases so far (e.g. to write partial results atomically).
+  std::function<void(const struct OpenStudyResult&)> on_scenario;
   DiagnoseOptions diagnose;
   bool IsValid(std::string* error) const;
 };
@@ -56,7 +60,7 @@ struct Proportion {
 
 struct OpenStudyResult {
   std::vector<OpenCase> cases;
-  std::vector<std::string> rows;
+  std::vector<std::string> rows;  // effect rows, then none
   std::vector<unsigned> skipped_seeds;  // no usable scenario for the seed (said in the report)
   double seconds = 0.0;
   Proportion PerRow(const std::string& row, NominalMode mode) const;
@@ -64,6 +68,9 @@ struct OpenStudyResult {
   Proportion NullFailReported(NominalMode mode) const;  // null cases above it that are reported as failed fits
   nlohmann::json to_json() const;
   std::string to_markdown(const std::string& command, bool verbose = false) const;  // verbose: evidence of misses
+  // Reads the cases of to_json() back (to merge shards); throws InputError.
+  static OpenStudyResult FromJson(const nlohmann::json& j);
+  void Merge(const OpenStudyResult& other);
 };
 
 // The rows: every effect at its usual location plus deadzone, saturation and quantization at the output.

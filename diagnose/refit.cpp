@@ -375,7 +375,10 @@ RefitResult Finish(const AugmentedModel& m, const Segment& s) {
   return r;
 }
 
-Vec PolyFromRoots(const std::vector<std::complex<double>>& roots) {
+
+}  // namespace
+
+Vec DenominatorFromRoots(const std::vector<std::complex<double>>& roots) {
   std::vector<std::complex<double>> c = {1.0};
   for (const auto& r : roots) {
     std::vector<std::complex<double>> n(c.size() + 1, 0.0);
@@ -389,8 +392,6 @@ Vec PolyFromRoots(const std::vector<std::complex<double>>& roots) {
   for (std::size_t i = 1; i < c.size(); ++i) a.push_back(c[i].real());
   return a;
 }
-
-}  // namespace
 
 bool LmOptions::IsValid(std::string* error) const {
   if (max_iterations < 0 || !(relative_tolerance > 0)) {
@@ -505,7 +506,7 @@ Vec StabilisedDenominator(const Vec& a) {
     }
     roots.push_back(r);
   }
-  return changed ? PolyFromRoots(roots) : a;
+  return changed ? DenominatorFromRoots(roots) : a;
 }
 
 bool FitArx(const Vec& x, const Vec& y, int na, int nb, int d, std::size_t skip, std::size_t end, bool with_constant,
