@@ -379,7 +379,7 @@ void Summarise(DiagnoseReport* rp) {
                              r.operating_point.y_removed ? fmt::format(" y = {:.4g}", r.operating_point.y) : "");
   if (r.feedback.detected)
     r.message += fmt::format(" Feedback detected: the input depends on past output residuals (Granger statistic {:.1f} > "
-                             "{:.1f}); the recording is closed-loop, every model is simulated from the recorded input.",
+                             "{:.1f}), as in a closed loop; every model is simulated from the recorded input.",
                              r.feedback.statistic, r.feedback.threshold);
 }
 
@@ -618,7 +618,9 @@ FeedbackTest DetectFeedback(const Vec& u, const Vec& e, std::size_t skip, int la
   const double dof = static_cast<double>(keep.size()) - (2 * lags + 1);
   if (!(rss1 > 1e-20 * tk.squaredNorm()) || dof < 1) return f;
   f.statistic = (rss0 - rss1) / (rss1 / dof);
-  f.threshold = ChiSquareQuantile(0.999, lags);
+  // 1e-5: the residual of a model that still misses something is not white either, and its past can
+  // predict a multisine a little (Silverbox, open loop: 35.6 against 41.3); a closed loop gives far more.
+  f.threshold = ChiSquareQuantile(1.0 - 1e-5, lags);
   f.detected = f.statistic > f.threshold;
   return f;
 }

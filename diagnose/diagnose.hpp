@@ -60,9 +60,10 @@ struct OperatingPoint {
 };
 
 // Feedback: does the input depend on past output residuals? A Granger test: u_t regressed on its own
-// past (lags 1..L) with and without the residual's past (lags 1..L); the F statistic x L is compared
-// with the chi^2_L 99.9 % quantile. In closed loop the noise reaches the input; the diagnosis still
-// simulates from the recorded input (output error stays consistent with white noise), and says so.
+// past (lags 1..L) with and without the residual's past (lags 1..L), the 10 % largest innovations of u
+// left out; the F statistic x L is compared with the chi^2_L quantile at 1 - 1e-5. In closed loop the
+// noise reaches the input; the diagnosis still simulates from the recorded input (output error stays
+// consistent with white noise), and says so.
 struct FeedbackTest {
   bool detected = false;
   double statistic = 0.0, threshold = 0.0;

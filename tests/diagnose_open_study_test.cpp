@@ -52,6 +52,7 @@ TEST(Feedback, ClosedLoopIsDetectedOpenLoopIsNot) {
     for (std::size_t t = 0; t < e.size(); ++t) e[t] -= yhat[t];
     if (sc.y_offset != 0.0) continue;  // keep the residual exact: only scenarios recorded around 0
     const FeedbackTest f = DetectFeedback(r.u, e, 0, 10);
+    std::cout << "feedback seed " << seed << " closed " << closed << " statistic " << f.statistic << "\n";
     EXPECT_EQ(f.detected, closed) << "seed " << seed << " statistic " << f.statistic << " threshold " << f.threshold;
     (closed ? closed_seen : open_seen)++;
   }
