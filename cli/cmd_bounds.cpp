@@ -1,20 +1,24 @@
 // `hwbounds bounds`: guaranteed parameter intervals of a Hammerstein–Wiener model from a recording.
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "cli/bounds_plot.hpp"
 #include "cli/commands.hpp"
+#include "cli/progress_display.hpp"
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
-#include "core/progress_throttle.hpp"
 #include "core/recording.hpp"
-#include "relax/box_split.hpp"
-#include "relax/set_membership.hpp"
+#include "exact/exact_bounds.hpp"
+#include "exact/exact_report.hpp"
+#include "exact/two_stage.hpp"
+#include "dss/bounds_report.hpp"
+#include "dss/box_split.hpp"
+#include "dss/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::cli {
@@ -37,7 +41,7 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
     if (!(in >> lo >> comma >> hi) || comma != ',' || !(in >> std::ws).eof())
       throw InputError(fmt::format("--box '{}': expected LO,HI (every parameter) or NAME=LO,HI", spec));
     RequireOption(fmt::format("--box '{}'", spec),
-                  [&](std::string* e) { return relax::ValidBoxEntry(target, lo, hi, names, e); });
+                  [&](std::string* e) { return dss::ValidBoxEntry(target, lo, hi, names, e); });
     for (std::size_t i = 0; i < names.size(); ++i)
       if (target.empty() || names[i] == target) box[i] = {lo, hi};
   }
@@ -62,8 +66,8 @@ std::vector<double> parse_list(const std::string& text, const std::string& what)
 
 // "--split gamma2=0" or "--split a1=1.7,1.8 --split b1=0": the prior box is cut at these values (one entry per
 // parameter). The text's syntax is checked here, the values against the box by the library's ValidBoxCuts.
-std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
-  std::vector<relax::BoxCut> cuts;
+std::vector<dss::BoxCut> parse_split(const std::vector<std::string>& specs) {
+  std::vector<dss::BoxCut> cuts;
   for (const auto& spec : specs) {
     const auto eq = spec.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
@@ -73,30 +77,46 @@ std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
   return cuts;
 }
 
-// Exit status of a run whose data prove that no parameter in the prior box fits (README, `bounds --help`).
+// Exit status of a run whose data prove that no parameter in the prior box fits (docs/input_output.md, `bounds --help`).
 constexpr int kExitInvalidated = 3;
 
 struct BoundsCliOptions {
   std::string data, u_col = "u", y_col = "y", noise_col, input_basis = "poly:3", output_basis = "poly:3";
-  std::string solver = "auto", json_out, run_dir, truth, executor = "fork";
+  std::string solver = "auto", json_out, plot_out, run_dir, truth, executor = "fork";
   std::vector<std::string> box, params, split;
   double noise_bound = 0.0;
   int na = 2, nb = 2, horizon = 2, order = 0, threads = 0;
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
-  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_moment_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verify = false, no_verify = false;
+  bool proper = false, no_cheap = false, no_edge_witnesses = false, no_moment_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verbose = false, verify = false, no_verify = false;
   int contraction_passes = 0;
-  int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
+  int stopped_short_refinements = dss::BoundsOptions{}.stopped_short_refinements;
   int endpoint_refinements = 0;
   int row_block_order = -1;
   int auto_split = 0;
+  std::string set = "dss";  // which feasible set the intervals bound: dss (D^ss(n)) or exact (D, after D^ss(n))
+  int lp_budget = exact::ObjectiveSearchOptions{}.lp_budget;
+  int sweeps = exact::ExactBoundsOptions{}.sweeps;
 };
 
-relax::HwData ReadData(const BoundsCliOptions& o) {
+// What the bounds of the exact set D need besides the D^ss(n) run: its start box is that run's result.
+exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss::BoundsOptions& dss) {
+  exact::ExactBoundsOptions options;
+  options.executor = dss.executor;
+  options.run_dir = o.run_dir;
+  options.parameters = o.params;
+  options.search.lp_budget = o.lp_budget;
+  options.sweeps = o.sweeps;
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  return options;
+}
+
+dss::HwData ReadData(const BoundsCliOptions& o) {
   std::vector<std::string> columns = {o.u_col, o.y_col};
   if (!o.noise_col.empty()) columns.push_back(o.noise_col);
   // A time column (t=VAR, or a CSV column t) is checked and not used: the model runs on the sample index.
   const CsvTable table = read_recording(o.data, columns, {"t"});
-  relax::HwData data;
+  dss::HwData data;
   data.source = o.data;
   data.lines = table.lines;
   data.u = table.column(o.u_col);
@@ -105,16 +125,16 @@ relax::HwData ReadData(const BoundsCliOptions& o) {
     data.noise_bound = table.column(o.noise_col);
   } else {
     if (!o.noise_bound_given) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
-    RequireOption("--noise-bound", [&](std::string* e) { return relax::ValidNoiseBound(o.noise_bound, e); });
+    RequireOption("--noise-bound", [&](std::string* e) { return dss::ValidNoiseBound(o.noise_bound, e); });
     data.noise_bound.assign(data.y.size(), o.noise_bound);
   }
   return data;
 }
 
-relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
-  relax::HwStructure structure;
-  structure.input_basis = relax::parse_basis(o.input_basis);
-  structure.output_basis = relax::parse_basis(o.output_basis);
+dss::HwStructure ReadStructure(const BoundsCliOptions& o) {
+  dss::HwStructure structure;
+  structure.input_basis = dss::parse_basis(o.input_basis);
+  structure.output_basis = dss::parse_basis(o.output_basis);
   structure.na = o.na;
   structure.nb = o.nb;
   structure.strictly_proper = !o.proper;
@@ -125,33 +145,33 @@ relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
 
 // The option values the library checks (the Python module's checks, with the same messages), before any work.
 void CheckBoundsOptions(const BoundsCliOptions& o) {
-  RequireOption("--horizon", [&](std::string* e) { return relax::ValidHorizon(o.horizon, e); });
-  if (o.order_given) RequireOption("--order", [&](std::string* e) { return relax::ValidOrder(o.order, o.horizon, e); });
-  RequireOption("--solver", [&](std::string* e) { return relax::ValidBoundsSolver(o.solver, e); });
-  RequireOption("--threads", [&](std::string* e) { return relax::ValidThreads(o.threads, e); });
+  RequireOption("--horizon", [&](std::string* e) { return dss::ValidHorizon(o.horizon, e); });
+  if (o.order_given) RequireOption("--order", [&](std::string* e) { return dss::ValidOrder(o.order, o.horizon, e); });
+  RequireOption("--solver", [&](std::string* e) { return dss::ValidBoundsSolver(o.solver, e); });
+  RequireOption("--threads", [&](std::string* e) { return dss::ValidThreads(o.threads, e); });
   RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
-  RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
-  RequireOption("--row-block-order", [&](std::string* e) { return relax::ValidBlockOrderCap(o.row_block_order, e); });
+  RequireOption("--contract-passes", [&](std::string* e) { return dss::ValidContractionPasses(o.contraction_passes, e); });
+  RequireOption("--row-block-order", [&](std::string* e) { return pop::ValidBlockOrderCap(o.row_block_order, e); });
   RequireOption("--stopped-short-refinements",
-                [&](std::string* e) { return relax::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
+                [&](std::string* e) { return dss::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
   RequireOption("--endpoint-refinements",
-                [&](std::string* e) { return relax::ValidEndpointRefinements(o.endpoint_refinements, e); });
-  RequireOption("--auto-split", [&](std::string* e) { return relax::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
+                [&](std::string* e) { return dss::ValidEndpointRefinements(o.endpoint_refinements, e); });
+  RequireOption("--auto-split", [&](std::string* e) { return dss::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
-std::string SolverText(const relax::BoundsOptions& options) {
+std::string SolverText(const dss::BoundsOptions& options) {
   if (options.solver != "auto") return options.solver;
   std::vector<std::string> parts;
   for (int d = std::min(options.order, 2); d <= options.order; ++d)  // the cheap pass runs at order 2 at most
     parts.push_back(fmt::format("{} at order {}",
-                                relax::SolverForOrder("auto", d, options.generation.block_order_cap), d));
+                                dss::SolverForOrder("auto", d, options.generation.block_order_cap), d));
   return fmt::format("auto ({})", fmt::join(parts, ", "));
 }
 
-relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
-  relax::BoundsOptions options;
-  options.order = o.order_given ? o.order : relax::MinimalOrder(o.horizon);
+dss::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
+  dss::BoundsOptions options;
+  options.order = o.order_given ? o.order : dss::MinimalOrder(o.horizon);
   options.solver = o.solver;
   options.threads = o.threads;
   options.executor = sdp::MakeExecutor(o.executor, o.threads);
@@ -167,220 +187,15 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
   options.generation.block_order_cap = o.row_block_order;
   options.parameters = o.params;
   options.generation.verify.enabled = !o.no_verify;
-  if (!o.quiet)  // one line per constraint-generation round, printed by the process that runs the job
+  if (o.verbose)  // one line per constraint-generation round, printed by the process that runs the job
     options.round_log = [](const std::string& line) { fmt::print(stderr, "  {}\n", line); };
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
   return options;
 }
 
-// The interval table; returns whether every given true value lies inside its interval.
-bool PrintIntervals(const relax::BoundsSummary& summary, const std::vector<std::string>& names,
-                    const std::vector<double>& truth) {
-  fmt::print("\n{:<10} {:>12} {:>12} {:>11}  {:<10} {:>19}  {:<25}  {}\n", "parameter", "lower", "upper", "half-width",
-             "verified", "correction lo/up", "feasible points reach", "status");
-  bool covered = true;
-  for (const auto& iv : summary.intervals) {
-    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
-    std::string status = iv.lower.status == "guaranteed" && iv.upper.status == "guaranteed"
-                             ? "guaranteed"
-                             : fmt::format("lower {}, upper {}", iv.lower.status, iv.upper.status);
-    if (!truth.empty()) {
-      const bool in = iv.lower.value <= truth[k] && truth[k] <= iv.upper.value;
-      covered = covered && in;
-      status += fmt::format("  truth {:.6g} {}", truth[k], in ? "inside" : "OUTSIDE");
-    }
-    const std::string verified = iv.lower.verification == iv.upper.verification
-                                     ? iv.lower.verification
-                                     : iv.lower.verification + "/" + iv.upper.verification;
-    // The inner side: certified points of the set reach this range, so the exact interval lies between the two.
-    const std::string reached = iv.witnessed_lower && iv.witnessed_upper
-                                    ? fmt::format("[{:.6f}, {:.6f}]", *iv.witnessed_lower, *iv.witnessed_upper)
-                                    : "-";
-    fmt::print("{:<10} {:>12.6f} {:>12.6f} {:>11.6f}  {:<10} {:>9.1e}/{:<9.1e}  {:<25}  {}\n", iv.name, iv.lower.value,
-               iv.upper.value, iv.half_width(), verified, iv.lower.correction, iv.upper.correction, reached, status);
-    for (const auto* ep : {&iv.lower, &iv.upper})
-      if (!ep->note.empty()) fmt::print("           note: {}\n", ep->note);
-  }
-  return covered;
-}
-
-// How one orthant was proven empty, for a person: "LP screen, verified in interval arithmetic".
-std::string CertificateText(const relax::EmptinessCertificate& c) {
-  const std::string how = c.kind == "lp"               ? "LP screen infeasible"
-                          : c.kind == "relaxation"     ? fmt::format("order {} relaxation infeasible", c.order)
-                          : c.kind == "pieces"         ? "proven empty in every piece of the split box"
-                                                       : fmt::format("order {} bounds cross", c.order);
-  return fmt::format("{}{}, {}", how, c.contracted_box ? " in the contracted box" : "",
-                     c.verified ? "verified in interval arithmetic" : "the solver's floating-point certificate (unverified)");
-}
-
-// The verdict of an empty feasible set: what it means, which certificates prove it, where to look next.
-void PrintInvalidation(const relax::BoundsSummary& summary, const BoundsCliOptions& o) {
-  fmt::print("\nVERDICT: model invalidated. No parameter in the prior box explains the data within the noise bound: "
-             "the model class (na = {}, nb = {}, input basis {}, output basis {}, horizon {}) or the noise bound is "
-             "wrong.\n",
-             o.na, o.nb, o.input_basis, o.output_basis, o.horizon);
-  std::map<std::string, int> by_certificate;
-  int verified = 0;
-  for (const auto& r : summary.orthants) {
-    ++by_certificate[r.status];
-    verified += r.certificate && r.certificate->verified ? 1 : 0;
-  }
-  std::string counts;
-  for (const auto& [kind, n] : by_certificate) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, kind);
-  fmt::print("certificates: all {} sign orthants are proven empty ({}); {} of them verified in interval arithmetic{}:\n",
-             summary.orthants_total, counts, verified, o.no_verify ? " (--no-verify)" : "");
-  for (const auto& r : summary.orthants)
-    fmt::print("  orthant {:>3} ({}): {}\n", r.index, r.signs, r.certificate ? CertificateText(*r.certificate) : r.status);
-  fmt::print("next: `hwbounds diagnose --data REC --validate REC2 --fit hw:NA,NB,PIN,POUT` looks for what the model "
-             "leaves out (docs/diagnose.md); a larger noise bound, other bases or orders, or a wider --box change the "
-             "question.\n");
-}
-
-// One line per piece of a split box: its box side(s) that differ from the prior box, and what it gave.
-void PrintPieces(const relax::BoundsSummary& summary) {
-  if (summary.pieces.empty()) return;
-  fmt::print("\nthe prior box split into {} pieces; the intervals above are the hull over the pieces:\n",
-             summary.pieces.size());
-  for (std::size_t k = 0; k < summary.pieces.size(); ++k) {
-    const auto& piece = summary.pieces[k];
-    std::string sides;
-    const auto& box = piece.at("prior_box");
-    for (std::size_t i = 0; i < box.size() && i < summary.box.size(); ++i)
-      if (box[i].at("lo").get<double>() != summary.box[i].first || box[i].at("hi").get<double>() != summary.box[i].second)
-        sides += fmt::format("{}{} in [{:.6g}, {:.6g}]", sides.empty() ? "" : ", ", box[i].at("parameter").get<std::string>(),
-                             box[i].at("lo").get<double>(), box[i].at("hi").get<double>());
-    std::string result;
-    if (piece.at("invalidated").get<bool>()) {
-      result = "every orthant proven empty";
-    } else {
-      for (const auto& iv : piece.at("intervals"))
-        result += fmt::format("{}{} [{:.6f}, {:.6f}]", result.empty() ? "" : ", ", iv.at("parameter").get<std::string>(),
-                              iv.at("lower").at("value").get<double>(), iv.at("upper").at("value").get<double>());
-    }
-    fmt::print("  piece {} ({}): {}; wall {:.1f} s\n", k + 1, sides, result,
-               piece.at("timing").at("wall_seconds").get<double>());
-  }
-}
-
-// One line per automatic round: the cut it added, the box it ran in (the sides the earlier rounds proved), and
-// what it gave.
-void PrintAutoSplitRounds(const relax::BoundsSummary& summary) {
-  if (summary.auto_split.is_null()) return;
-  const auto& rounds = summary.auto_split.at("rounds");
-  fmt::print("\nautomatic cuts: {} round(s) after the first run ({}); each bounds D^ss(n) in the prior box, the "
-             "last one's intervals are those above:\n",
-             rounds.size() - 1, summary.auto_split.at("stopped").get<std::string>());
-  for (const auto& round : rounds) {
-    const auto& cut = round.at("cut");
-    std::string what = cut.is_null() ? std::string("first run")
-                                     : fmt::format("cut {} = {:.6g} ({:.0f}% of its interval unwitnessed)",
-                                                   cut.at("parameter").get<std::string>(), cut.at("value").get<double>(),
-                                                   100 * cut.at("unwitnessed_fraction").get<double>());
-    std::string intervals;
-    for (const auto& iv : round.at("intervals"))
-      intervals += fmt::format("{}{} [{:.6f}, {:.6f}]", intervals.empty() ? "" : ", ",
-                               iv.at("parameter").get<std::string>(), iv.at("lower").get<double>(),
-                               iv.at("upper").get<double>());
-    fmt::print("  round {} ({}, {} piece(s)): {}; wall {:.1f} s\n", round.at("round").get<int>(), what,
-               round.at("pieces").get<std::size_t>(),
-               round.at("invalidated").get<bool>() ? std::string("every orthant proven empty") : intervals,
-               round.at("wall_seconds").get<double>());
-  }
-}
-
-// Where the relaxation may overestimate most: the largest part of an interval no certified point reaches, from
-// 10 % of its width on, with the cut that bounds that part on its own.
-void PrintUnwitnessedPart(const relax::BoundsSummary& summary) {
-  const auto part = relax::LargestUnwitnessedPart(summary);
-  if (!part || part->fraction < 0.1) return;
-  fmt::print("\nlargest unwitnessed part: no certified feasible point has {} in {} ({:.0f}% of its interval); the "
-             "relaxation may overestimate there. A cut just {} {:.6g} (--split {}=VALUE, or --auto-split 1 to place it) "
-             "bounds that part on its own and may prove it empty (README, \"Box split\").\n",
-             part->parameter,
-             part->below ? fmt::format("[{:.6g}, {:.6g})", part->bound, part->witnessed)
-                         : fmt::format("({:.6g}, {:.6g}]", part->witnessed, part->bound),
-             100 * part->fraction, part->below ? "below" : "above", part->witnessed, part->parameter);
-}
-
-void PrintRunSummary(const relax::BoundsSummary& summary, const std::vector<std::string>& names, bool verify) {
-  fmt::print("\nprior box (assumption): ");
-  for (std::size_t i = 0; i < names.size(); ++i)
-    fmt::print("{}{} in [{}, {}]", i ? ", " : "", names[i], summary.box[i].first, summary.box[i].second);
-  for (const auto& [l, b] : summary.orthant_boxes) {
-    fmt::print("\ncontracted box of orthant {} (proven to hold its points of D^ss(n) in the prior box): ", l);
-    for (std::size_t i = 0; i < names.size(); ++i)
-      fmt::print("{}{} in [{:.6g}, {:.6g}]", i ? ", " : "", names[i], b[i].first, b[i].second);
-  }
-  fmt::print("\nrelaxation: {}", summary.relaxation);
-  fmt::print("\northants: {} total, {} proven empty, {} solved, {} failed; {} relaxation jobs ({} SDP solves, "
-             "{} from cache), largest SDP {} moments / {} blocks, median solve {:.2f} s, wall {:.1f} s\n",
-             summary.orthants_total, summary.orthants_empty, summary.orthants_solved, summary.orthants_failed,
-             summary.sdp_jobs, summary.sdp_solves, summary.jobs_from_cache, summary.largest_moments,
-             summary.largest_blocks, summary.median_solve_seconds, summary.wall_seconds);
-  if (summary.edge_witness_solves > 0)
-    fmt::print("feasible points at the box edges: {} endpoint(s) settled without an SDP ({} local solves, {:.1f} s)\n",
-               summary.edge_witness_settled, summary.edge_witness_solves, summary.edge_witness_seconds);
-  if (summary.moment_witness_jobs > 0)
-    fmt::print("feasible points from the relaxations' moments: {} of {} local searches certified ({:.1f} s)\n",
-               summary.moment_witness_found, summary.moment_witness_jobs, summary.moment_witness_seconds);
-  if (summary.jobs_stopped_beyond_witness > 0)
-    fmt::print("{} relaxation job(s) ended early: their bound passed a certified feasible point's value, so further "
-               "rounds could not move the endpoint\n", summary.jobs_stopped_beyond_witness);
-  if (summary.refine_jobs > 0)
-    fmt::print("{} endpoint job(s) solved again in a contracted box after a solve stopped short; {} bound(s) "
-               "tightened\n", summary.refine_jobs, summary.refine_tightened);
-  if (summary.endpoint_refine_jobs > 0)
-    fmt::print("{} endpoint job(s) solved again in the box of the full pass's own bounds; {} bound(s) tightened\n",
-               summary.endpoint_refine_jobs, summary.endpoint_refine_tightened);
-  if (summary.jobs_settled_by_sign > 0)
-    fmt::print("{} relaxation job(s) not run: the orthant's sign constraints already bound them at or beyond a "
-               "certified feasible point's value\n", summary.jobs_settled_by_sign);
-  for (const auto& r : summary.row_reduction) {
-    std::string steps;
-    for (const auto& c : r.at("per_step"))
-      if (c.contains("error"))
-        steps += fmt::format("{}step {}: reduction failed ({}), every row of the orthant kept", steps.empty() ? "" : ", ",
-                             c.value("step", 0), c.at("error").get<std::string>());
-      else if (c.contains("step"))
-        steps += fmt::format("{}step {}: {} of {}{}", steps.empty() ? "" : ", ", c.at("step").get<int>(),
-                             c.at("kept").get<int>(), c.at("rows").get<int>(),
-                             c.value("iteration_limited", 0) > 0
-                                 ? fmt::format(" ({} kept after their LP hit the simplex iteration limit)",
-                                               c.at("iteration_limited").get<int>())
-                                 : std::string());
-    fmt::print("exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);
-  }
-  if (!summary.bound_sources.empty()) {
-    std::string sources;
-    for (const auto& [what, count] : summary.bound_sources)
-      sources += fmt::format("{}{} {}", sources.empty() ? "" : ", ", count, what);
-    fmt::print("orthant bounds entering the endpoints: {}\n", sources);
-  }
-  if (summary.clipped_to_box) fmt::print("note: endpoints beyond the prior box are intersected with it\n");
-  if (verify)
-    fmt::print("verification: {:.2f} s for {:.2f} s of SDP solves ({:.1f}%)\n", summary.verify_seconds,
-               summary.solve_seconds,
-               summary.solve_seconds > 0 ? 100 * summary.verify_seconds / summary.solve_seconds : 0.0);
-}
-
-void PrintWarnings(const relax::BoundsSummary& summary, bool verify) {
-  if (!summary.all_guaranteed())
-    fmt::print("WARNING: some endpoints are conservative fallbacks (still valid bounds) or floating-point bounds that "
-               "verification could not prove (see notes and the verified column).\n");
-  if (!verify) return;
-  for (const auto& iv : summary.intervals)
-    for (const auto* ep : {&iv.lower, &iv.upper})
-      if (ep->verification == "unverified") {
-        fmt::print("WARNING: {} has an endpoint that rests on an unverified floating-point bound (see notes).\n",
-                   iv.name);
-        break;
-      }
-}
-
 // The result JSON; an invalidated model has "invalidated": true and null interval values.
-nlohmann::json ResultJson(const relax::BoundsSummary& summary, const BoundsCliOptions& o, const relax::HwOuterSet& set,
+nlohmann::json ResultJson(const dss::BoundsSummary& summary, const BoundsCliOptions& o, const dss::HwOuterSet& set,
                           const std::vector<double>& truth, bool covered) {
   auto j = summary.to_json();  // "invalidated", the verdict, null intervals and each orthant's certificate
   j["data"] = o.data;
@@ -428,11 +243,11 @@ void AddBoundsCommand(CLI::App& app) {
   cmd->add_option("--split", o->split,
                   "cut the prior box at these values of one parameter, NAME=VALUE[,VALUE...] (repeat for more "
                   "parameters): each piece is bounded on its own and the intervals are the hull over the pieces, "
-                  "often tighter (README, \"The relaxation gap\")");
+                  "often tighter (docs/cerone_tables.md, \"The relaxation gap at δ = 3\")");
   cmd->add_option("--auto-split", o->auto_split,
                   "after the run, up to this many rounds (0..5): shrink the box to the verified intervals, cut off "
                   "the largest part of an interval no certified feasible point reaches (from 10% of its width) just "
-                  "beyond that point, and bound again over the pieces (README, \"Box split\")");
+                  "beyond that point, and bound again over the pieces (docs/setmembership.md, \"Box split\")");
   cmd->add_option("--solver", o->solver,
                   fmt::format("SDP backend: auto (CSDP, measured fastest at orders 2 and 3; docs/sdp.md), {}",
                               fmt::join(sdp::AvailableSolvers(), ", ")));
@@ -473,24 +288,41 @@ void AddBoundsCommand(CLI::App& app) {
       ->excludes(verify);
   cmd->add_option("--params", o->params, "only these intervals (names such as a1 b1)")->delimiter(',')->default_str("all");
   cmd->add_option("--truth", o->truth, "comma list of true parameters, to report coverage (simulation studies)");
+  cmd->add_option("--set", o->set,
+                  "which feasible set to bound: dss (D^ss(n) of paper 001, sign orthants and moment relaxations) or "
+                  "exact (the exact set D, one noise sequence for the whole record, bounded by lifted LPs and branch "
+                  "and bound inside the D^ss(n) box; 3-2000 times narrower; docs/exact_set.md). exact assumes the "
+                  "inverse output map increases on the data range")
+      ->check(CLI::IsMember({"dss", "exact"}));
+  cmd->add_option("--lp-budget", o->lp_budget, "--set exact: LPs per endpoint refinement (>= 1)");
+  cmd->add_option("--sweeps", o->sweeps, "--set exact: bounding sweeps, each in the box the previous proved (1..5)");
   cmd->add_option("--json", o->json_out, "write the result as JSON");
-  cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  cmd->add_option("--plot", o->plot_out,
+                  "draw the intervals as a PNG (gnuplot): each in its prior box and stretched to its own width, with "
+                  "the certified feasible points and --truth");
+  auto* quiet = cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  cmd->add_flag("--verbose", o->verbose,
+                "also one line per constraint-generation round of every job (working set, solver status, bound so "
+                "far), and progress as plain lines")
+      ->excludes(quiet);
   cmd->callback([o, order, noise_bound] {
     o->order_given = order->count() > 0;
     o->noise_bound_given = noise_bound->count() > 0;
     CheckBoundsOptions(*o);
     if (!o->json_out.empty()) CheckOutputFile(o->json_out, "--json");
+    const std::string plot_terminal = o->plot_out.empty() ? "" : CheckPlotOutput(o->plot_out);
     if (!o->run_dir.empty()) CheckOutputDirectory(o->run_dir, "--run-dir");
-    const relax::HwData data = ReadData(*o);
-    const relax::HwStructure structure = ReadStructure(*o);
-    const auto names = relax::MakeLayout(structure).names;
-    const relax::BoundsOptions options = MakeBoundsOptions(*o);
-    const relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
-    const std::vector<relax::BoxCut> cuts = parse_split(o->split);
-    RequireOption("--split", [&](std::string* e) { return relax::ValidBoxCuts(cuts, names, set.box(), e); });
+    const dss::HwData data = ReadData(*o);
+    const dss::HwStructure structure = ReadStructure(*o);
+    const auto names = dss::MakeLayout(structure).names;
+    const dss::BoundsOptions options = MakeBoundsOptions(*o);
+    const dss::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
+    const std::vector<dss::BoxCut> cuts = parse_split(o->split);
+    RequireOption("--split", [&](std::string* e) { return dss::ValidBoxCuts(cuts, names, set.box(), e); });
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
-      relax::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
+      const auto outer = dss::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
+      if (o->set == "exact") exact::ComputeExactBounds(MakeExactOptions(*o, options), structure, data, exact::StartBoxFromOuter(outer, set));
       return;
     }
     std::vector<double> truth;
@@ -503,35 +335,54 @@ void AddBoundsCommand(CLI::App& app) {
                "{} sign orthants, solver {}, jobs on {} ({} workers)\n",
                data.y.size(), o->data, o->na, o->nb, o->horizon, options.order, names.size(), set.num_orthants(),
                SolverText(options), options.executor->name(), options.executor->workers());
-    ProgressThrottle throttle(5.0);  // a line per phase start and end, and at most one every 5 s in between
-    auto progress = [o, &throttle](const relax::BoundsProgress& p) {
-      if (o->quiet) return;
-      if (p.total < 0) {  // a one-off message
-        fmt::print(stderr, "{}\n", p.phase);
-        return;
-      }
-      if (!throttle.Due(p.elapsed_seconds, p.done <= 0 || p.done >= p.total)) return;
-      fmt::print(stderr, "[{}] {}/{} jobs{}, elapsed {:.0f} s, ETA {:.0f} s\n", p.phase, p.done, p.total,
-                 p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
-                 p.elapsed_seconds, p.eta_seconds);
-    };
-    relax::AutoSplitOptions auto_split;
+    std::fflush(stdout);  // the header before the progress lines on stderr
+    ProgressDisplay display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
+    dss::AutoSplitOptions auto_split;
     auto_split.rounds = o->auto_split;
-    const auto summary = relax::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split, progress);
+    const auto summary = dss::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split,
+                                                           [&display](const dss::BoundsProgress& p) { display.Show(p); });
+    display.Finish();
     const bool invalidated = summary.invalidated();
-    bool covered = true;
-    if (invalidated) PrintInvalidation(summary, *o);
-    else covered = PrintIntervals(summary, names, truth);
-    PrintPieces(summary);
-    PrintAutoSplitRounds(summary);
-    PrintRunSummary(summary, names, !o->no_verify);
-    if (!invalidated) PrintWarnings(summary, !o->no_verify);
-    PrintUnwitnessedPart(summary);
-    if (!o->json_out.empty()) {
-      write_text_atomic(o->json_out, ResultJson(summary, *o, set, truth, covered).dump(2) + "\n");
-      fmt::print("wrote {}\n", o->json_out);
+    const bool covered = dss::TruthCovered(summary, truth);
+    dss::BoundsReportOptions report;
+    report.truth = truth;
+    report.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", o->na, o->nb,
+                                     o->input_basis, o->output_basis, o->horizon);
+    report.verify = !o->no_verify;
+    fmt::print("{}", dss::FullReport(summary, report));
+    nlohmann::json result = ResultJson(summary, *o, set, truth, covered);
+    result["set"] = "dss";
+    bool exact_invalidated = false;
+    if (o->set == "exact" && !invalidated) {
+      std::fflush(stdout);
+      ProgressDisplay exact_display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
+      const auto exact_summary = exact::ComputeExactBounds(
+          MakeExactOptions(*o, options), structure, data, exact::StartBoxFromOuter(summary, set),
+          [&exact_display](const exact::ExactBoundsProgress& p) {
+            dss::BoundsProgress line;
+            line.phase = "exact set: " + p.phase;
+            line.done = p.done;
+            line.total = p.total;
+            line.elapsed_seconds = p.elapsed_seconds;
+            exact_display.Show(line);
+          });
+      exact_display.Finish();
+      exact::ExactReportOptions exact_report;
+      exact_report.truth = truth;
+      for (const auto& iv : exact::StartBoxFromOuter(summary, set)) exact_report.outer.emplace_back(iv.lo, iv.hi);
+      exact_report.outer_label = fmt::format("D^ss({})", o->horizon);
+      exact_report.stage1_seconds = summary.wall_seconds;
+      exact_report.model_class = report.model_class + ", noise bound per sample from the recording or --noise-bound";
+      fmt::print("{}", exact::ExactReport(exact_summary, exact_report));
+      result = exact::ExactResultJson(exact_summary, result, summary, truth);
+      exact_invalidated = exact_summary.invalidated;
     }
-    if (invalidated) throw CommandExit{kExitInvalidated};
+    OutputFiles outputs;  // all or none, each renamed into place whole
+    if (!o->json_out.empty()) outputs.Add(o->json_out, result.dump(2) + "\n");
+    if (!o->plot_out.empty()) outputs.Add(o->plot_out, RenderBoundsPlot(summary, truth, plot_terminal));
+    outputs.Commit();
+    for (const auto& [path, bytes] : outputs.files()) fmt::print("wrote {}\n", path);
+    if (invalidated || exact_invalidated) throw CommandExit{kExitInvalidated};
   });
 }
 

@@ -78,7 +78,7 @@ void AddDiagnoseCommand(CLI::App& app) {
   auto p = std::make_shared<Opts>();
   cmd->add_option("--data", p->data, "identification recording: FILE or FILE:u=NAME,y=NAME[,t=NAME]")->required();
   cmd->add_option("--validate", p->validate, "validation recording: FILE or FILE:u=NAME,y=NAME[,t=NAME]")->required();
-  auto* m = cmd->add_option("--model", p->model, "nominal model JSON (README: Model JSON)");
+  auto* m = cmd->add_option("--model", p->model, "nominal model JSON (docs/input_output.md: Model JSON)");
   auto* f = cmd->add_option("--fit", p->fit, "fit the nominal model first: linear:NA,NB[,DELAY] or hw:NA,NB,PIN,POUT[,DELAY]");
   m->excludes(f);
   cmd->add_option("--out", p->out, "output directory (report.json, report.md, figures)")->required();

@@ -7,8 +7,8 @@
 #include "cli/commands.hpp"
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
-#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
+#include "core/output_files.hpp"
 #include "core/recording.hpp"
 
 namespace hw::cli {
@@ -35,7 +35,7 @@ void AddSimulateCommand(CLI::App& app) {
     bool allow_unstable = false;
   };
   auto o = std::make_shared<Opts>();
-  auto* model = cmd->add_option("--model", o->model, "model JSON (see README: Model JSON)");
+  auto* model = cmd->add_option("--model", o->model, "model JSON (see docs/input_output.md: Model JSON)");
   auto* input = cmd->add_option("--input", o->input, "recording with the input column (CSV, or FILE.mat:u=VAR[,t=VAR])");
   auto* example = cmd->add_option("--example", o->example,
                                   "built-in example instead of --model/--input: cerone2011 (paper 001, Section VI)")

@@ -1,6 +1,6 @@
 #pragma once
 // The project's Hammerstein–Wiener model: input static map -> discrete LTI block -> output static map.
-// One JSON format (documented in README "Model JSON") is written by the estimators and read by
+// One JSON format (documented in docs/input_output.md, "Model JSON") is written by the estimators and read by
 // `simulate`, `diagnose` and `compare`.
 //
 // Linear block convention (paper 001 eq. 3, used everywhere in hwbounds):

@@ -82,6 +82,10 @@ void OutputFiles::Commit() {
 
 bool GnuplotAvailable() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
+bool GnuplotHasTerminal(const std::string& name) {
+  return std::system(fmt::format("gnuplot -e 'set terminal {}' > /dev/null 2>&1", name).c_str()) == 0;
+}
+
 std::string RunGnuplot(const std::string& dir, const std::string& script) {
   const std::string cmd = fmt::format("cd '{}' && gnuplot '{}' > '{}.log' 2>&1", dir, script, script);
   if (std::system(cmd.c_str()) == 0) return "";

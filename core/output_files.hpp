@@ -17,6 +17,8 @@ void CheckOutputDirectory(const std::string& path, const std::string& option);
 
 // Whether gnuplot is on the PATH (figures are optional: without it, callers keep the data and scripts).
 bool GnuplotAvailable();
+// Whether that gnuplot has the output terminal `name` (e.g. "pngcairo").
+bool GnuplotHasTerminal(const std::string& name);
 // Runs `script` (a file name inside `dir`) with gnuplot in `dir`, its output to `script`.log there. Returns ""
 // on success, otherwise a message naming the log.
 std::string RunGnuplot(const std::string& dir, const std::string& script);

@@ -106,7 +106,7 @@ struct AugmentedModel {
   std::vector<double> simulate(const std::vector<double>& u) const;
   AugmentedModel WithoutBlocks() const;  // same numbers, blocks switched off
   nlohmann::json to_json() const;
-  // Reads a plain model JSON or an augmented one (README "Model JSON" + the keys above). Unknown or
+  // Reads a plain model JSON or an augmented one (docs/input_output.md "Model JSON" + the keys above). Unknown or
   // misspelt keys are an error naming the key. Throws InputError.
   static AugmentedModel from_json(const nlohmann::json& j);
   static AugmentedModel Load(const std::string& path);  // errors name the file

@@ -2,7 +2,7 @@
 """Independent check that parameter points lie in D^ss(n) of paper 001 (Cerone, Piga, Regruto), Result 1.
 
 Plain Python (standard library only), written from the paper and NOT sharing code with hwbounds' C++
-HwOuterSet, so that a bug there cannot hide here. Reading used (the same as README's): eq. (3)
+HwOuterSet, so that a bug there cannot hide here. Reading used (the same as docs/setmembership.md's): eq. (3)
 z_t = -a1 z_{t-1} - a2 z_{t-2} + b1 x_{t-1} + b2 x_{t-2}; companion matrix A = [[-a1, -a2], [1, 0]];
 for horizon s: z_t - sum_h [A^s](1,h) z_{t-s-h+1} = sum_{k=1..s} [A^{s-k}](1,1) v_{t-s+k}, v = b1 x_{t-1} + b2 x_{t-2};
 every term kappa * alpha_j * w_tau^j of the left side is bounded independently over |eta_tau| <= dy_tau.

@@ -5,9 +5,11 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -245,6 +247,61 @@ TEST_F(CliIo, NegativeNoiseBoundNamesTheFileLine) {
   const auto r = Cli("bounds --data " + Path("neg.csv") + " --noise-col noise_bound --horizon 1 --quiet");
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_TRUE(Has(r.output, "neg.csv:11")) << r.output;
+}
+
+// A run without --verbose shows its phases, not the constraint-generation rounds of every job (hundreds of lines
+// on the bundled example); --verbose shows them. Output to a pipe: plain progress lines.
+TEST_F(CliIo, RoundLinesOnlyWithVerbose) {
+  const std::string run = "bounds --data " + Path("rec.csv") + " --noise-col noise_bound --horizon 1 --order 1 --threads 1 --params a1";
+  const auto plain = Cli(run);
+  ASSERT_EQ(plain.code, 0) << plain.output;
+  EXPECT_TRUE(Has(plain.output, "[LP screen of orthants] ")) << plain.output;
+  EXPECT_FALSE(Has(plain.output, "] round 1:")) << plain.output;
+  EXPECT_FALSE(Has(plain.output, "\r")) << "a pipe gets no in-place updates: " << plain.output;
+  EXPECT_LE(std::count(plain.output.begin(), plain.output.end(), '\n'), 40) << plain.output;
+  const auto verbose = Cli(run + " --verbose");
+  ASSERT_EQ(verbose.code, 0) << verbose.output;
+  EXPECT_TRUE(Has(verbose.output, "] round 1:")) << verbose.output;
+  const auto quiet = Cli(run + " --quiet");
+  EXPECT_FALSE(Has(quiet.output, "[LP screen of orthants]")) << quiet.output;
+  EXPECT_NE(Cli(run + " --quiet --verbose").code, 0);
+}
+
+// On a terminal each phase is one line rewritten in place (run under script(1), which gives it a terminal).
+TEST_F(CliIo, TerminalGetsOneLivePhaseLine) {
+  if (std::system("command -v script > /dev/null 2>&1") != 0) GTEST_SKIP() << "script(1) is not installed";
+  const std::string run = std::string(HW_CLI_PATH) + " bounds --data " + Path("rec.csv") +
+                          " --noise-col noise_bound --horizon 1 --order 1 --threads 1 --params a1";
+  const auto r = testing_support::RunCommand("script -qec '" + run + "' /dev/null 2>&1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Has(r.output, "\r\033[K[LP screen of orthants] ")) << r.output;
+  EXPECT_FALSE(Has(r.output, "] round 1:")) << r.output;
+}
+
+TEST_F(CliIo, PlotWritesAPng) {
+  const auto r = Cli(Bounds("--order 1 --threads 1 --params a1,a2 --plot " + Path("bounds.png") +
+                            " --truth 0.4,-0.1,0.8,3.2,1.8,0.9,1.6,2.1"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Has(r.output, "wrote " + Path("bounds.png"))) << r.output;
+  std::ifstream in(Path("bounds.png"), std::ios::binary);
+  std::string magic(8, '\0');
+  in.read(magic.data(), 8);
+  EXPECT_EQ(magic, std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_FALSE(fs::exists(Path("bounds.png.tmp")));
+}
+
+// --plot is checked before any work: a name that is not .png, and no gnuplot on the PATH.
+TEST_F(CliIo, PlotWithoutGnuplotIsRefusedBeforeAnyWork) {
+  const auto jpg = Cli(Bounds("--order 1 --plot " + Path("bounds.jpg")));
+  EXPECT_EQ(jpg.code, 2) << jpg.output;
+  EXPECT_TRUE(Has(jpg.output, "ending in .png")) << jpg.output;
+  fs::create_directories(Path("empty_bin"));
+  const auto r = testing_support::RunCommand("PATH=" + Path("empty_bin") + " " + HW_CLI_PATH + " " +
+                                             Bounds("--order 1 --plot " + Path("bounds.png")) + " 2>&1");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_TRUE(Has(r.output, "gnuplot is not on the PATH")) << r.output;
+  EXPECT_FALSE(Has(r.output, "orthants:")) << "it ran: " << r.output;
+  EXPECT_FALSE(fs::exists(Path("bounds.png")));
 }
 
 TEST_F(CliIo, HelpShowsDefaultsAndTheVerifyPair) {

@@ -29,11 +29,11 @@ struct CliRun {
   double seconds = 0;
 };
 
-#ifdef HW_CLI_PATH
-inline CliRun RunCli(const std::string& args) {
+// Runs a shell command line, e.g. "PATH=/empty prog args 2>&1", and collects its standard output.
+inline CliRun RunCommand(const std::string& command) {
   const auto t0 = std::chrono::steady_clock::now();
   CliRun r;
-  FILE* p = ::popen((std::string(HW_CLI_PATH) + " " + args + " 2>&1").c_str(), "r");
+  FILE* p = ::popen(command.c_str(), "r");
   char buf[4096];
   std::size_t n;
   while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
@@ -42,6 +42,9 @@ inline CliRun RunCli(const std::string& args) {
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
+
+#ifdef HW_CLI_PATH
+inline CliRun RunCli(const std::string& args) { return RunCommand(std::string(HW_CLI_PATH) + " " + args + " 2>&1"); }
 #endif
 
 }  // namespace hw::testing_support

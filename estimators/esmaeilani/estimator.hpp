@@ -169,7 +169,7 @@ struct Summary {
   bool ok() const { return status != Status::kFailed; }
 };
 
-// The model file `hwbounds esmaeilani` writes: the project model (README: Model JSON) of the estimate, with
+// The model file `hwbounds esmaeilani` writes: the project model (docs/input_output.md: Model JSON) of the estimate, with
 // the paper's parametrisation, the known information and the final costs under "esmaeilani".
 nlohmann::json ModelFileJson(const EsmaeilaniModel& m, const Options& options, const Constraints& constraints,
                              const Summary& summary);

@@ -50,6 +50,21 @@ def test_same_result_as_the_cli(recording, tmp_path):
     assert without(py, "timing") == without(cli, "timing")
 
 
+def test_report_is_the_text_the_cli_prints(recording):
+    path, rec = recording
+    out, _ = run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 1,
+                     "--params", "a1,b1", "--solver", "csdp", "--threads", 2, "--quiet")
+    py = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1, parameters=["a1", "b1"],
+                         solver="csdp", threads=2, source=path, report=True)
+    brief, full = py["brief_report"], py["full_report"]
+    assert "\na1 " in brief and "\nb1 " in brief and "guaranteed" in brief, brief
+    table = brief.split("\nWARNING")[0]  # warnings follow the run's summary in the full report
+    assert table in out, (table, out)  # as the CLI prints it (a table holds no times)
+    assert full.startswith(table) and "prior box (assumption): " in full, full
+    assert "brief_report" not in hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=1,
+                                                 parameters=["a1"], solver="csdp", threads=2, source=path)
+
+
 def test_cli_bounds_from_a_mat_file_equal_those_from_the_csv(recording, tmp_path):
     path, rec = recording
     mat = tmp_path / "rec.mat"

@@ -1,0 +1,208 @@
+#include "exact/box_evaluation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "exact/safe_bound.hpp"
+
+namespace hw::exact {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The slack LP of a window: a rigorous lower bound of the largest residual, and the solve itself.
+struct SlackSolve {
+  double lower_bound = -1.0;
+  LpResult result;
+};
+
+SlackSolve SolveSlack(const LiftedData& data, const ParamBox& box, Window window, const BoxEvaluationOptions& options,
+                      LpSolver& solver, const LpBasis& warm) {
+  LiftedLp lifted = BuildLiftedLp(data, box, window, LiftedForm::kFeasibility);
+  lifted.SetSlackObjective();
+  SlackSolve out;
+  out.result = solver.Solve(lifted.lp, warm, options.lp);
+  // Any dual vector certifies: even a solve that stopped early may prove the box empty.
+  if (!out.result.duals.empty()) out.lower_bound = SafeLowerBound(lifted.lp, out.result.duals);
+  return out;
+}
+
+std::vector<double> ParameterValues(const LiftedLp& lifted, const std::vector<double>& primal) {
+  std::vector<double> p;
+  if (primal.size() != static_cast<std::size_t>(lifted.lp.num_cols())) return p;
+  for (int col : lifted.param_col) p.push_back(primal[col]);
+  return p;
+}
+
+// The b_j (index into beta_col) of one sign over the box farthest from zero, or -1.
+int RatioDenominator(const LiftedData& data, const ParamBox& box) {
+  const auto& lay = data.layout;
+  int best = -1;
+  double best_margin = 0.0;
+  for (int j = 0; lay.b_begin + j < lay.count(); ++j) {
+    const Interval b = box[lay.b_begin + j];
+    const double margin = b.lo > 0 ? b.lo : (b.hi < 0 ? -b.hi : 0.0);
+    if (margin > best_margin) best_margin = margin, best = j;
+  }
+  return best;
+}
+
+}  // namespace
+
+std::string Objective::name() const { return fmt::format("{} #{}", maximise ? "max" : "min", parameter); }
+
+nlohmann::json PruneCertificate::to_json() const {
+  return {{"window", {window.begin, window.end}}, {"residual_lower_bound", residual_lower_bound}};
+}
+
+PruneCertificate PruneCertificate::from_json(const nlohmann::json& j) {
+  PruneCertificate c;
+  c.window = {j.at("window").at(0).get<int>(), j.at("window").at(1).get<int>()};
+  c.residual_lower_bound = j.at("residual_lower_bound").get<double>();
+  return c;
+}
+
+bool BoxEvaluationOptions::IsValid(std::string* error) const {
+  if (cheap_window < 0 || cheap_windows < 0) {
+    if (error) *error = "cheap windows: length and count must be >= 0";
+    return false;
+  }
+  return lp.IsValid(error);
+}
+
+Window WholeRecord(const LiftedData& data) { return {0, data.num_samples}; }
+
+std::vector<Window> CheapWindows(const LiftedData& data, int length, int count) {
+  std::vector<Window> windows;
+  if (length <= 0 || count <= 0 || 2 * length > data.num_samples) return windows;
+  for (int c = 0; c < count; ++c) {
+    const int begin = count == 1 ? 0 : static_cast<int>(static_cast<long>(data.num_samples - length) * c / (count - 1));
+    windows.push_back({begin, begin + length});
+  }
+  return windows;
+}
+
+BoxEvaluation TestBoxEmpty(const LiftedData& data, const ParamBox& box, const BoxEvaluationOptions& options,
+                           LpSolver& solver, const LpBasis& warm) {
+  const auto start = Clock::now();
+  BoxEvaluation out;
+  auto finish = [&]() {
+    out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return out;
+  };
+  std::vector<Window> windows = CheapWindows(data, options.cheap_window, options.cheap_windows);
+  windows.push_back(WholeRecord(data));
+  for (const Window& w : windows) {
+    const bool whole = w == WholeRecord(data);
+    SlackSolve s = SolveSlack(data, box, w, options, solver, whole ? warm : LpBasis{});
+    ++out.lps;
+    if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
+    if (s.lower_bound > 0.0) {
+      out.verdict = BoxVerdict::kPruned;
+      out.certificate = PruneCertificate{w, s.lower_bound};
+      return finish();
+    }
+    if (whole) {
+      out.basis = s.result.basis;
+      const LiftedLp shape = BuildLiftedLp(data, box, w, LiftedForm::kFeasibility);
+      out.point = ParameterValues(shape, s.result.primal);
+    }
+  }
+  return finish();
+}
+
+namespace {
+
+// One LP of the bounding form with objective `sign * (obj)`; returns the rigorous lower bound of sign * obj.
+struct BoundSolve {
+  double lower_bound = -INFINITY;
+  LpResult result;
+};
+
+BoundSolve SolveBound(LiftedLp& lifted, LpSolver& solver, const LpBasis& warm, const LpSolveOptions& options) {
+  BoundSolve out;
+  out.result = solver.Solve(lifted.lp, warm, options);
+  if (out.result.status == LpStatus::kOptimal) out.lower_bound = SafeLowerBound(lifted.lp, out.result.duals);
+  return out;
+}
+
+}  // namespace
+
+BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
+                             const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm) {
+  const auto start = Clock::now();
+  const auto& lay = data.layout;
+  const double sign = objective.maximise ? -1.0 : 1.0;  // every LP minimises sign * objective
+  LiftedLp lifted = BuildLiftedLp(data, box, WholeRecord(data), LiftedForm::kBounding);
+  BoxEvaluation out;
+  auto failed_lp = [&]() {
+    // Infeasible (or failed) in floating point: only a certificate may drop the box.
+    BoxEvaluation empty = TestBoxEmpty(data, box, options, solver, warm);
+    empty.lps += out.lps;
+    empty.lp_failures += out.lp_failures;
+    empty.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return empty;
+  };
+  const bool is_gamma = objective.parameter >= lay.gamma_begin && objective.parameter < lay.gamma_begin + lay.num_gamma;
+  const int ratio_j = is_gamma ? RatioDenominator(data, box) : -1;
+  if (ratio_j < 0) {
+    std::vector<double> weights(lay.count(), 0.0);
+    weights[objective.parameter] = sign;
+    lifted.SetParameterObjective(weights);
+    BoundSolve s = SolveBound(lifted, solver, warm, options.lp);
+    ++out.lps;
+    if (s.result.status != LpStatus::kOptimal) {
+      ++out.lp_failures;
+      return failed_lp();
+    }
+    out.bound = sign * s.lower_bound;
+    out.lp_value = sign * s.result.objective;
+    out.point = ParameterValues(lifted, s.result.primal);
+    out.basis = s.result.basis;
+  } else {
+    // gamma_k = beta_jk / b_j with b_j of one sign: Dinkelbach steps g <- beta*/b*, then the certificate
+    // min sigma*sign*(beta_jk - g b_j) >= m  =>  gamma_k >= g + m / b (the b end chosen by the sign of m).
+    const int k = objective.parameter - lay.gamma_begin + 1;  // beta column index (0 is b_j)
+    const Interval b = box[lay.b_begin + ratio_j];
+    const double sigma = b.lo > 0 ? 1.0 : -1.0;
+    const double b_near = sigma > 0 ? b.lo : -b.hi, b_far = sigma > 0 ? b.hi : -b.lo;  // |b| range, > 0
+    double g = box[objective.parameter].mid();
+    LpBasis basis = warm;
+    std::optional<double> best;
+    for (int step = 0; step < 8; ++step) {
+      lifted.SetRatioObjective(ratio_j, k, g);
+      for (double& c : lifted.lp.obj) c *= sigma * sign;
+      BoundSolve s = SolveBound(lifted, solver, basis, options.lp);
+      ++out.lps;
+      if (s.result.status != LpStatus::kOptimal) {
+        ++out.lp_failures;
+        if (best) break;
+        return failed_lp();
+      }
+      basis = s.result.basis;
+      out.basis = s.result.basis;
+      out.point = ParameterValues(lifted, s.result.primal);
+      // sign * (gamma - g) * |b| >= m over the box  =>  sign * gamma >= sign * g + m / |b|.
+      const double m = s.lower_bound;
+      // 1/|b| is itself rounded: widen it outward by an ulp on each side.
+      const Interval inv = m >= 0 ? Interval(RoundDown(1.0 / b_far), RoundUp(1.0 / b_far))
+                                  : Interval(RoundDown(1.0 / b_near), RoundUp(1.0 / b_near));
+      const double signed_bound = (Interval(sign * g) + Interval(m) * inv).lo;
+      const double candidate = sign * signed_bound;
+      if (!best || (objective.maximise ? candidate < *best : candidate > *best)) best = candidate;
+      const double beta = s.result.primal[lifted.beta_col[ratio_j][k]], bj = s.result.primal[lifted.beta_col[ratio_j][0]];
+      out.lp_value = beta / bj;
+      const double g_next = beta / bj;
+      if (!std::isfinite(g_next) || std::abs(g_next - g) <= 1e-12 * std::max(1.0, std::abs(g))) break;
+      g = g_next;
+    }
+    out.bound = best;
+  }
+  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+}  // namespace hw::exact

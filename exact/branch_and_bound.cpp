@@ -1,0 +1,177 @@
+#include "exact/branch_and_bound.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace hw::exact {
+
+int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& start) {
+  const auto& lay = data.layout;
+  int best = lay.a_begin;
+  double best_ratio = -1.0;
+  for (int i = 0; i < data.structure.na; ++i) {
+    const int k = lay.a_begin + i;
+    const double ratio = (box[k].hi - box[k].lo) / (start[k].hi - start[k].lo);
+    if (ratio > best_ratio) best_ratio = ratio, best = k;
+  }
+  return best;
+}
+
+std::pair<ParamBox, ParamBox> HalveBox(const ParamBox& box, int parameter) {
+  ParamBox lower = box, upper = box;
+  const double mid = box[parameter].mid();
+  lower[parameter].hi = mid;
+  upper[parameter].lo = mid;
+  return {lower, upper};
+}
+
+ParamBox HullOf(const std::vector<ParamBox>& boxes) {
+  ParamBox hull = boxes.front();
+  for (const auto& b : boxes)
+    for (std::size_t k = 0; k < hull.size(); ++k) hull[k] = Hull(hull[k], b[k]);
+  return hull;
+}
+
+bool PruneStop::IsValid(std::string* error) const {
+  if (max_levels < 0 || max_boxes < 1 || !(resolution >= 1.0)) {
+    if (error) *error = "pruning stop: max_levels >= 0, max_boxes >= 1 and resolution >= 1 are required";
+    return false;
+  }
+  return true;
+}
+
+bool PruneSearchDone(const LiftedData& data, const std::vector<ParamBox>& live, int level, const PruneStop& stop) {
+  if (live.empty() || level >= stop.max_levels || static_cast<int>(live.size()) > stop.max_boxes) return true;
+  const ParamBox hull = HullOf(live);
+  const auto& lay = data.layout;
+  for (const auto& box : live)
+    for (int i = 0; i < data.structure.na; ++i) {
+      const int k = lay.a_begin + i;
+      if ((box[k].hi - box[k].lo) * stop.resolution > (hull[k].hi - hull[k].lo)) return false;
+    }
+  return true;
+}
+
+bool ObjectiveSearchOptions::IsValid(std::string* error) const {
+  if (lp_budget < 1 || !(min_relative_width > 0)) {
+    if (error) *error = "objective search: lp_budget >= 1 and min_relative_width > 0 are required";
+    return false;
+  }
+  return true;
+}
+
+nlohmann::json ObjectiveSearchResult::to_json() const {
+  nlohmann::json certs = nlohmann::json::array();
+  for (const auto& c : certificates) certs.push_back(c.to_json());
+  return {{"bound", bound}, {"lp_value", lp_value}, {"from_lp", from_lp}, {"empty", empty}, {"lps", lps},
+          {"lp_failures", lp_failures}, {"boxes_pruned", boxes_pruned}, {"boxes_left", boxes_left},
+          {"certificates", certs}, {"point", point}, {"seconds", seconds}};
+}
+
+ObjectiveSearchResult ObjectiveSearchResult::from_json(const nlohmann::json& j) {
+  ObjectiveSearchResult r;
+  r.bound = j.at("bound").get<double>();
+  r.lp_value = j.at("lp_value").get<double>();
+  r.from_lp = j.at("from_lp").get<bool>();
+  r.empty = j.at("empty").get<bool>();
+  r.lps = j.at("lps").get<int>();
+  r.lp_failures = j.at("lp_failures").get<int>();
+  r.boxes_pruned = j.at("boxes_pruned").get<int>();
+  r.boxes_left = j.at("boxes_left").get<int>();
+  for (const auto& c : j.at("certificates")) r.certificates.push_back(PruneCertificate::from_json(c));
+  r.point = j.at("point").get<std::vector<double>>();
+  r.seconds = j.at("seconds").get<double>();
+  return r;
+}
+
+nlohmann::json BoxToJson(const ParamBox& box) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& iv : box) j.push_back({iv.lo, iv.hi});
+  return j;
+}
+
+ParamBox BoxFromJson(const nlohmann::json& j) {
+  ParamBox box;
+  for (const auto& iv : j) box.emplace_back(iv.at(0).get<double>(), iv.at(1).get<double>());
+  return box;
+}
+
+namespace {
+
+struct SearchBox {
+  ParamBox box;
+  double bound = 0.0;      // in minimisation terms: sign * objective >= bound over the box
+  bool evaluated = false;  // an LP tightened (or confirmed) the bound on this very box
+  bool from_lp = false;
+  double lp_value = 0.0;
+  std::vector<double> point;
+  LpBasis basis;
+};
+
+}  // namespace
+
+ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
+                                      const Objective& objective, std::optional<double> target, double target_gap,
+                                      const ObjectiveSearchOptions& options, const BoxEvaluationOptions& evaluation,
+                                      LpSolver& solver) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double sign = objective.maximise ? -1.0 : 1.0;
+  const int p = objective.parameter;
+  std::vector<SearchBox> live;
+  for (const auto& b : boxes) live.push_back({b, objective.maximise ? -b[p].hi : b[p].lo});
+  ObjectiveSearchResult out;
+  while (!live.empty()) {
+    // The box holding the worst bound (the first of equals: deterministic).
+    std::size_t w = 0;
+    for (std::size_t i = 1; i < live.size(); ++i)
+      if (live[i].bound < live[w].bound) w = i;
+    SearchBox& box = live[w];
+    if (!box.evaluated) {
+      if (out.lps >= options.lp_budget) break;
+      BoxEvaluation e = BoundObjective(data, box.box, objective, evaluation, solver, box.basis);
+      out.lps += e.lps;
+      out.lp_failures += e.lp_failures;
+      if (e.verdict == BoxVerdict::kPruned) {
+        out.certificates.push_back(*e.certificate);
+        ++out.boxes_pruned;
+        live.erase(live.begin() + static_cast<long>(w));
+        continue;
+      }
+      box.evaluated = true;
+      if (e.bound && sign * *e.bound > box.bound) {
+        box.bound = sign * *e.bound;
+        box.from_lp = true;
+        box.lp_value = e.lp_value;
+      }
+      if (!e.point.empty()) box.point = e.point;
+      if (!e.basis.empty()) box.basis = e.basis;
+      continue;
+    }
+    if (target && box.bound >= sign * *target - target_gap) break;  // within the target of a point of D
+    if (out.lps >= options.lp_budget) break;
+    const int k = SplitParameter(data, box.box, start);
+    if (box.box[k].hi - box.box[k].lo < options.min_relative_width * (start[k].hi - start[k].lo)) break;
+    auto [lower, upper] = HalveBox(box.box, k);
+    SearchBox a{lower, box.bound, false, box.from_lp, box.lp_value, box.point, box.basis};
+    SearchBox b{upper, box.bound, false, box.from_lp, box.lp_value, box.point, box.basis};
+    live.erase(live.begin() + static_cast<long>(w));
+    live.insert(live.begin() + static_cast<long>(w), {a, b});
+  }
+  out.boxes_left = static_cast<int>(live.size());
+  if (live.empty()) {
+    out.empty = true;
+  } else {
+    std::size_t w = 0;
+    for (std::size_t i = 1; i < live.size(); ++i)
+      if (live[i].bound < live[w].bound) w = i;
+    out.bound = sign * live[w].bound;
+    out.from_lp = live[w].from_lp;
+    out.lp_value = live[w].from_lp ? live[w].lp_value : out.bound;
+    out.point = live[w].point;
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace hw::exact

@@ -1,0 +1,66 @@
+#pragma once
+// Branch and bound over the dynamics (a_1..a_na) for the exact set D: the two searches of the engine.
+//  - PruneLevel: one level of the pruning search: every live box is halved along its relatively widest a_i
+//    and each half is tested for emptiness (exact/box_evaluation.hpp). Levels repeat until the live boxes are
+//    small against their hull (PruneStop).
+//  - SearchObjective: best-first refinement of one endpoint over the live boxes: the box holding the worst
+//    bound is bounded by an LP, or halved when it already was, until the bound is within a target of a known
+//    point of D, or the LP budget is spent. Its result is the worst bound over the boxes left, so a box is
+//    only ever dropped with a certificate.
+// Both are pure functions of their inputs (no timing, no worker identity), so any executor gives the same
+// numbers.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "exact/box_evaluation.hpp"
+
+namespace hw::exact {
+
+// The index (in the layout) of the a_i to halve: the widest relative to the start box's width.
+int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& start);
+std::pair<ParamBox, ParamBox> HalveBox(const ParamBox& box, int parameter);
+// The hull of boxes (per parameter).
+ParamBox HullOf(const std::vector<ParamBox>& boxes);
+
+struct PruneStop {
+  int max_levels = 80;       // levels of halving
+  int max_boxes = 48;        // live boxes: past this the search stops halving
+  double resolution = 2.0;   // stop once every live box is at most 1/resolution of the live hull in every a_i
+  bool IsValid(std::string* error) const;
+};
+// Whether the pruning search has reached its stop (boxes small against their hull, or a limit).
+bool PruneSearchDone(const LiftedData& data, const std::vector<ParamBox>& live, int level, const PruneStop& stop);
+
+struct ObjectiveSearchOptions {
+  int lp_budget = 16;              // LPs of one endpoint's refinement
+  double min_relative_width = 1e-9;  // a box narrower than this (relative to the start box) is not halved
+  bool IsValid(std::string* error) const;
+};
+
+struct ObjectiveSearchResult {
+  double bound = 0.0;          // rigorous: no point of D in the boxes is beyond it
+  double lp_value = 0.0;       // the floating-point LP value of the box attaining the bound
+  bool from_lp = false;        // false: the bound is an edge of a box that no LP tightened
+  bool empty = false;          // every box was proven empty
+  int lps = 0, lp_failures = 0, boxes_pruned = 0, boxes_left = 0;
+  std::vector<PruneCertificate> certificates;
+  std::vector<double> point;   // the LP point of the box attaining the bound
+  double seconds = 0.0;
+  nlohmann::json to_json() const;
+  static ObjectiveSearchResult from_json(const nlohmann::json& j);
+};
+
+// `target`: a value of the objective at a known point of D (the inner hull); the search stops when the bound
+// is within `target_gap` of it. Without a target it spends its budget.
+ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
+                                      const Objective& objective, std::optional<double> target, double target_gap,
+                                      const ObjectiveSearchOptions& options, const BoxEvaluationOptions& evaluation,
+                                      LpSolver& solver);
+
+nlohmann::json BoxToJson(const ParamBox& box);
+ParamBox BoxFromJson(const nlohmann::json& j);
+
+}  // namespace hw::exact

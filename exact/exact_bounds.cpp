@@ -1,0 +1,361 @@
+#include "exact/exact_bounds.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/csv_table.hpp"
+#include "dss/bound_jobs.hpp"
+#include "exact/exact_jobs.hpp"
+
+namespace hw::exact {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Runs specs on the executor, reading and storing answers in the run directory. A failed job's answer is
+// null: the caller keeps what it concerned (a box stays live; an endpoint falls back to the box edge).
+class JobRunner {
+ public:
+  JobRunner(sdp::JobExecutor& executor, const dss::RunCache& cache, const sdp::JobFunction& fn, ExactBoundsSummary& s)
+      : executor_(executor), cache_(cache), fn_(fn), summary_(s) {}
+  // `on_done(done, total)` after each job run here (jobs read from the run directory count as done at once).
+  std::vector<nlohmann::json> Run(const std::vector<nlohmann::json>& specs,
+                                  const std::function<void(int, int)>& on_done = {}) {
+    std::vector<nlohmann::json> answers(specs.size());
+    std::vector<std::string> texts, keys;
+    std::vector<std::size_t> todo;
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      const std::string text = specs[i].dump();
+      const std::string key = JobKey(text);
+      if (auto cached = cache_.load(key)) {
+        answers[i] = *cached;
+        ++summary_.jobs_from_cache;
+        continue;
+      }
+      texts.push_back(text);
+      keys.push_back(key);
+      todo.push_back(i);
+    }
+    int done = static_cast<int>(specs.size() - todo.size());
+    const auto results = executor_.Map(texts, fn_, [&](std::size_t, const sdp::JobResult&) {
+      if (on_done) on_done(++done, static_cast<int>(specs.size()));
+    });
+    for (std::size_t n = 0; n < todo.size(); ++n) {
+      ++summary_.jobs;
+      if (!results[n].ok) continue;  // stays null
+      answers[todo[n]] = nlohmann::json::parse(results[n].text);
+      cache_.store(keys[n], answers[todo[n]]);
+    }
+    return answers;
+  }
+
+ private:
+  sdp::JobExecutor& executor_;
+  const dss::RunCache& cache_;
+  const sdp::JobFunction& fn_;
+  ExactBoundsSummary& summary_;
+};
+
+struct LiveBox {
+  ParamBox box;
+  LpBasis basis;
+  std::vector<double> point;
+};
+
+// Stage 1: halve and test until the live boxes are small against their hull.
+std::vector<LiveBox> Prune(const LiftedData& data, const ParamBox& start, const PruneStop& stop, JobRunner& runner,
+                           ExactBoundsSummary& s, const std::function<void(const ExactBoundsProgress&)>& progress,
+                           Clock::time_point t0) {
+  std::vector<LiveBox> live = {{start, {}, {}}};
+  int level = 0;
+  bool cheap_windows = true;  // until a level's cheap windows prune nothing
+  while (level == 0 || !PruneSearchDone(data, [&] {
+           std::vector<ParamBox> b;
+           for (const auto& l : live) b.push_back(l.box);
+           return b;
+         }(), level, stop)) {
+    std::vector<LiveBox> children;
+    std::vector<nlohmann::json> specs;
+    for (const auto& l : live) {
+      auto [lower, upper] = HalveBox(l.box, SplitParameter(data, l.box, start));
+      for (auto& c : {lower, upper}) {
+        children.push_back({c, l.basis, l.point});
+        specs.push_back(EmptinessJobSpec(c, l.basis, cheap_windows));
+      }
+    }
+    const auto answers = runner.Run(specs);
+    std::vector<LiveBox> next;
+    bool window_pruned = false;
+    for (std::size_t i = 0; i < children.size(); ++i) {
+      ++s.boxes_evaluated;
+      if (answers[i].is_null()) {  // the job failed: the box stays
+        next.push_back(children[i]);
+        continue;
+      }
+      const EmptinessAnswer a = EmptinessAnswer::from_json(answers[i]);
+      s.lps += a.lps;
+      s.lp_failures += a.lp_failures;
+      if (a.verdict == BoxVerdict::kPruned) {
+        ++s.boxes_pruned;
+        window_pruned = window_pruned || !(a.certificate->window == WholeRecord(data));
+        s.certificates.push_back({{"box", BoxToJson(children[i].box)}, {"certificate", a.certificate->to_json()}});
+        continue;
+      }
+      next.push_back({children[i].box, a.basis, a.point});
+    }
+    live = std::move(next);
+    cheap_windows = cheap_windows && window_pruned;
+    ++level;
+    if (progress && !live.empty()) {
+      std::vector<ParamBox> b;
+      for (const auto& l : live) b.push_back(l.box);
+      const ParamBox hull = HullOf(b);
+      const int a1 = data.layout.a_begin;
+      progress({"prune (levels)", level, stop.max_levels,
+                fmt::format("{} boxes live, {} in [{:.6g}, {:.6g}]", live.size(), data.layout.names[a1], hull[a1].lo,
+                            hull[a1].hi),
+                SecondsSince(t0)});
+    }
+    if (live.empty()) break;
+    if (static_cast<int>(live.size()) > stop.max_boxes || level >= stop.max_levels) break;
+  }
+  s.prune_levels = level;
+  return live;
+}
+
+std::vector<int> WantedParameters(const ExactBoundsOptions& options, const dss::ParameterLayout& lay) {
+  std::vector<int> wanted;
+  for (int k = 0; k < lay.count(); ++k)
+    if (options.parameters.empty() ||
+        std::find(options.parameters.begin(), options.parameters.end(), lay.names[k]) != options.parameters.end())
+      wanted.push_back(k);
+  return wanted;
+}
+
+// Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter) refined.
+void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
+                const InnerHull* inner, double target_ratio, JobRunner& runner, ExactBoundsSummary& s,
+                std::vector<ExactInterval>& intervals, const std::function<void(int, int)>& on_done) {
+  const auto& lay = data.layout;
+  std::vector<nlohmann::json> specs;
+  std::vector<Objective> objectives;
+  for (int k = 0; k < lay.count(); ++k)
+    for (bool maximise : {false, true}) {
+      std::optional<double> target;
+      double gap = 0.0;
+      if (inner && inner->ranges[k]) {
+        const auto [lo, hi] = *inner->ranges[k];
+        target = maximise ? hi : lo;
+        // Each end may be this far outside the inner hull for outer/inner <= target_ratio.
+        gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
+      }
+      objectives.push_back({k, maximise});
+      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap));
+    }
+  const auto answers = runner.Run(specs, on_done);
+  for (std::size_t o = 0; o < objectives.size(); ++o) {
+    const Objective& obj = objectives[o];
+    ExactEndpoint& end = obj.maximise ? intervals[obj.parameter].upper : intervals[obj.parameter].lower;
+    if (answers[o].is_null()) continue;  // the job failed: the endpoint keeps what it had
+    const ObjectiveSearchResult r = ObjectiveSearchResult::from_json(answers[o]);
+    s.lps += r.lps;
+    s.lp_failures += r.lp_failures;
+    s.boxes_pruned += r.boxes_pruned;
+    if (r.empty) {
+      end.status = EndpointStatus::kEmpty;
+      continue;
+    }
+    // Keep the tighter of two valid bounds (an earlier sweep's, this one's).
+    const bool tighter = obj.maximise ? r.bound < end.value : r.bound > end.value;
+    if (tighter || end.status == EndpointStatus::kConservative) {
+      if (tighter) end.value = r.bound;
+      end.status = r.from_lp || !tighter ? (r.from_lp ? EndpointStatus::kGuaranteed : end.status) : EndpointStatus::kConservative;
+      end.correction = std::abs(r.bound - r.lp_value);
+    }
+  }
+}
+
+AssumptionCheck CheckAssumption(const LiftedData& data, const std::vector<ExactInterval>& intervals) {
+  AssumptionCheck c;
+  c.grid_points = static_cast<int>(data.grid.size());
+  const auto& lay = data.layout;
+  c.smallest_increase = INFINITY;
+  for (std::size_t m = 0; m + 1 < data.grid.size(); ++m) {
+    Interval inc = data.phi_grid[m + 1][0] - data.phi_grid[m][0];
+    for (int j = 0; j < lay.num_alpha; ++j) {
+      const auto& iv = intervals[lay.alpha_begin + j];
+      inc += Interval(iv.lower.value, iv.upper.value) * (data.phi_grid[m + 1][j + 1] - data.phi_grid[m][j + 1]);
+    }
+    if (inc.lo < c.smallest_increase) {
+      c.smallest_increase = inc.lo;
+      c.where_lo = data.grid[m];
+      c.where_hi = data.grid[m + 1];
+    }
+  }
+  c.holds = c.smallest_increase > 0.0;
+  return c;
+}
+
+}  // namespace
+
+std::string ToString(EndpointStatus status) {
+  switch (status) {
+    case EndpointStatus::kGuaranteed: return "guaranteed";
+    case EndpointStatus::kConservative: return "conservative";
+    case EndpointStatus::kEmpty: return "empty";
+  }
+  return "conservative";
+}
+
+std::string MonotoneAssumptionText() {
+  return "the inverse output map p(alpha, w) = sum_j alpha_j phi_j(w) increases on the data range "
+         "[min(y - dy), max(y + dy)] (paper 001 takes it invertible; alpha_1 = 1 fixes the sign)";
+}
+
+bool ExactBoundsOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  if (!ValidLpSolverName(lp_solver, error)) return false;
+  if (!evaluation.IsValid(error) || !prune.IsValid(error) || !search.IsValid(error)) return false;
+  if (sweeps < 1 || sweeps > 5) return fail(fmt::format("sweeps must be 1..5, not {}", sweeps));
+  if (!(target_ratio >= 1.0)) return fail("target_ratio must be >= 1");
+  if (threads < 0) return fail("threads must be >= 0 (0 = one per core)");
+  if (inner_hull && !inner.IsValid(error)) return false;
+  return true;
+}
+
+nlohmann::json AssumptionCheck::to_json() const {
+  return {{"assumption", MonotoneAssumptionText()}, {"holds", holds}, {"smallest_increase", smallest_increase},
+          {"where", {where_lo, where_hi}}, {"grid_points", grid_points}};
+}
+
+nlohmann::json ExactBoundsSummary::to_json() const {
+  nlohmann::json ivs = nlohmann::json::array();
+  for (const auto& iv : intervals) {
+    auto end = [](const ExactEndpoint& e) {
+      return nlohmann::json{{"value", e.value}, {"status", ToString(e.status)},
+                            {"verification", e.verified ? "verified" : "unverified"}, {"correction", e.correction}};
+    };
+    nlohmann::json j = {{"name", iv.name}, {"lower", end(iv.lower)}, {"upper", end(iv.upper)}};
+    if (iv.inner) j["inner"] = {iv.inner->first, iv.inner->second};
+    ivs.push_back(j);
+  }
+  return {{"intervals", ivs},
+          {"start_box", BoxToJson(start_box)},
+          {"invalidated", invalidated},
+          {"certificates", certificates},
+          {"assumption", assumption.to_json()},
+          {"stage2",
+           {{"prune_levels", prune_levels}, {"boxes_evaluated", boxes_evaluated}, {"boxes_pruned", boxes_pruned},
+            {"boxes_live", boxes_live}, {"lps", lps}, {"lp_failures", lp_failures}, {"jobs", jobs},
+            {"jobs_from_cache", jobs_from_cache}, {"lp_rows", lp_rows}, {"lp_cols", lp_cols},
+            {"lp_nonzeros", lp_nonzeros}, {"prune_seconds", prune_seconds}, {"inner_seconds", inner_seconds},
+            {"bound_seconds", bound_seconds}, {"wall_seconds", wall_seconds}, {"inner_points", inner_points},
+            {"executor", executor}}}};
+}
+
+ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
+                                      const dss::HwData& data, const ParamBox& start_box,
+                                      const std::function<void(const ExactBoundsProgress&)>& progress) {
+  const auto t0 = Clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  const LiftedData lifted = MakeLiftedData(structure, data);
+  const auto& lay = lifted.layout;
+  if (static_cast<int>(start_box.size()) != lay.count())
+    throw InputError(fmt::format("the start box has {} entries for {} parameters", start_box.size(), lay.count()));
+  const ExactJobSettings settings{options.lp_solver, options.evaluation, options.search};
+  const sdp::JobFunction fn = MakeExactJobFunction(lifted, settings);
+  const auto executor = options.executor ? options.executor : std::make_shared<sdp::ForkExecutor>(options.threads);
+  ExactBoundsSummary s;
+  if (!executor->is_coordinator()) {
+    executor->Serve(fn);
+    s.worker_rank = true;
+    return s;
+  }
+  struct SessionEnd {
+    sdp::JobExecutor& e;
+    ~SessionEnd() { e.EndSession(); }
+  } session_end{*executor};
+  s.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
+  s.parameter_names = lay.names;
+  s.start_box = start_box;
+  {
+    const LiftedLp shape = BuildLiftedLp(lifted, start_box, WholeRecord(lifted), LiftedForm::kFeasibility);
+    s.lp_rows = shape.lp.num_rows();
+    s.lp_cols = shape.lp.num_cols();
+    s.lp_nonzeros = static_cast<long>(shape.lp.entries.size());
+  }
+  nlohmann::json meta = {{"engine", "exact"}, {"start_box", BoxToJson(start_box)}};
+  const std::string key = JobKey(meta.dump() + std::to_string(lifted.num_samples));
+  const dss::RunCache cache(options.run_dir, "exact-" + key, meta);
+  JobRunner runner(*executor, cache, fn, s);
+
+  // 1. prune
+  auto t = Clock::now();
+  const std::vector<LiveBox> live = Prune(lifted, start_box, options.prune, runner, s, progress, t0);
+  s.prune_seconds = SecondsSince(t);
+  s.boxes_live = static_cast<int>(live.size());
+  for (int k = 0; k < lay.count(); ++k) {
+    ExactInterval iv{lay.names[k], {start_box[k].lo, EndpointStatus::kConservative}, {start_box[k].hi, EndpointStatus::kConservative}, {}};
+    s.intervals.push_back(iv);
+  }
+  if (live.empty()) {
+    s.invalidated = true;
+    for (auto& iv : s.intervals) iv.lower.status = iv.upper.status = EndpointStatus::kEmpty;
+    s.wall_seconds = SecondsSince(t0);
+    return s;
+  }
+  s.certificates.clear();  // kept only as the proof of an empty set
+  std::vector<ParamBox> boxes;
+  for (const auto& l : live) boxes.push_back(l.box);
+  ParamBox proven = HullOf(boxes);
+  // The a_i of the live hull are already bounds.
+  for (int i = 0; i < structure.na; ++i) {
+    const int k = lay.a_begin + i;
+    s.intervals[k].lower = {proven[k].lo, EndpointStatus::kGuaranteed};
+    s.intervals[k].upper = {proven[k].hi, EndpointStatus::kGuaranteed};
+  }
+
+  // 2. inner hull
+  std::optional<InnerHull> inner;
+  if (options.inner_hull) {
+    t = Clock::now();
+    if (progress) progress({"inner hull (local searches)", 0, 1, "", SecondsSince(t0)});
+    auto solver = MakeLpSolver(options.lp_solver);
+    std::vector<double> start_point = live.front().point;
+    if (start_point.empty())
+      for (const auto& iv : proven) start_point.push_back(iv.mid());
+    inner = ComputeInnerHull(lifted, proven, start_point, options.inner, *solver);
+    s.inner_seconds = SecondsSince(t);
+    s.inner_points = static_cast<int>(inner->points.size());
+    for (int k = 0; k < lay.count(); ++k) s.intervals[k].inner = inner->ranges[k];
+  }
+
+  // 3. bound, in sweeps: each later sweep starts in the box the earlier ones proved.
+  t = Clock::now();
+  for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+    const std::string phase = fmt::format("bound (sweep {} of {}, endpoints)", sweep + 1, options.sweeps);
+    ParamBox sweep_start = start_box;
+    for (int k = 0; k < lay.count(); ++k) sweep_start[k] = Interval(s.intervals[k].lower.value, s.intervals[k].upper.value);
+    // Each endpoint's search starts from the live hull (one box): it halves only where its bound is worst, which
+    // costs fewer LPs than bounding every live box of the pruning search first.
+    const std::vector<ParamBox> sweep_boxes = {sweep_start};
+    BoundSweep(lifted, sweep_start, sweep_boxes, inner ? &*inner : nullptr, options.target_ratio, runner, s, s.intervals,
+               [&](int done, int total) {
+                 if (progress) progress({phase, done, total, "", SecondsSince(t0)});
+               });
+  }
+  s.bound_seconds = SecondsSince(t);
+  s.assumption = CheckAssumption(lifted, s.intervals);
+  s.wall_seconds = SecondsSince(t0);
+  return s;
+}
+
+}  // namespace hw::exact

@@ -1,0 +1,91 @@
+#include "exact/exact_jobs.hpp"
+
+#include <cstdint>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace hw::exact {
+
+std::string EncodeBasis(const LpBasis& basis) {
+  static const char* hex = "0123456789abcdef";
+  std::string s;
+  s.reserve(2 * basis.status.size());
+  for (std::uint8_t b : basis.status) {
+    s.push_back(hex[b >> 4]);
+    s.push_back(hex[b & 15]);
+  }
+  return s;
+}
+
+LpBasis DecodeBasis(const std::string& text) {
+  auto nibble = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    throw std::invalid_argument("basis: not a hex digit");
+  };
+  LpBasis b;
+  if (text.size() % 2) throw std::invalid_argument("basis: odd length");
+  for (std::size_t i = 0; i < text.size(); i += 2)
+    b.status.push_back(static_cast<std::uint8_t>(nibble(text[i]) * 16 + nibble(text[i + 1])));
+  return b;
+}
+
+std::string JobKey(const std::string& spec) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : spec) h = (h ^ c) * 1099511628211ULL;
+  return fmt::format("{:016x}", h);
+}
+
+nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool cheap_windows) {
+  return {{"kind", "empty"}, {"box", BoxToJson(box)}, {"warm", EncodeBasis(warm)}, {"cheap", cheap_windows}};
+}
+
+nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
+                                std::optional<double> target, double target_gap) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& b : boxes) list.push_back(BoxToJson(b));
+  nlohmann::json j = {{"kind", "objective"}, {"start", BoxToJson(start)}, {"boxes", list},
+                      {"parameter", objective.parameter}, {"maximise", objective.maximise}, {"target_gap", target_gap}};
+  j["target"] = target ? nlohmann::json(*target) : nlohmann::json(nullptr);
+  return j;
+}
+
+EmptinessAnswer EmptinessAnswer::from_json(const nlohmann::json& j) {
+  EmptinessAnswer a;
+  a.verdict = j.at("pruned").get<bool>() ? BoxVerdict::kPruned : BoxVerdict::kKept;
+  if (j.contains("certificate")) a.certificate = PruneCertificate::from_json(j.at("certificate"));
+  a.point = j.at("point").get<std::vector<double>>();
+  a.basis = DecodeBasis(j.at("basis").get<std::string>());
+  a.lps = j.at("lps").get<int>();
+  a.lp_failures = j.at("lp_failures").get<int>();
+  return a;
+}
+
+sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSettings& settings) {
+  return [&data, settings](const std::string& text) {
+    const nlohmann::json spec = nlohmann::json::parse(text);
+    auto solver = MakeLpSolver(settings.lp_solver);
+    if (spec.at("kind") == "empty") {
+      BoxEvaluationOptions evaluation = settings.evaluation;
+      if (!spec.at("cheap").get<bool>()) evaluation.cheap_windows = 0;
+      const BoxEvaluation e = TestBoxEmpty(data, BoxFromJson(spec.at("box")), evaluation, *solver,
+                                           DecodeBasis(spec.at("warm").get<std::string>()));
+      nlohmann::json out = {{"pruned", e.verdict == BoxVerdict::kPruned}, {"point", e.point},
+                            {"basis", EncodeBasis(e.basis)}, {"lps", e.lps}, {"lp_failures", e.lp_failures}};
+      if (e.certificate) out["certificate"] = e.certificate->to_json();
+      return out.dump();
+    }
+    std::vector<ParamBox> boxes;
+    for (const auto& b : spec.at("boxes")) boxes.push_back(BoxFromJson(b));
+    const Objective objective{spec.at("parameter").get<int>(), spec.at("maximise").get<bool>()};
+    std::optional<double> target;
+    if (!spec.at("target").is_null()) target = spec.at("target").get<double>();
+    const ObjectiveSearchResult r =
+        SearchObjective(data, BoxFromJson(spec.at("start")), boxes, objective, target,
+                        spec.at("target_gap").get<double>(), settings.search, settings.evaluation, *solver);
+    return r.to_json().dump();
+  };
+}
+
+}  // namespace hw::exact

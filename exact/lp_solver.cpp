@@ -1,0 +1,49 @@
+#include "exact/lp_solver.hpp"
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "exact/clp_solver.hpp"
+
+namespace hw::exact {
+
+std::string ToString(LpStatus status) {
+  switch (status) {
+    case LpStatus::kOptimal: return "optimal";
+    case LpStatus::kInfeasible: return "infeasible";
+    case LpStatus::kUnbounded: return "unbounded";
+    case LpStatus::kIterationLimit: return "iteration limit";
+    case LpStatus::kFailed: return "failed";
+  }
+  return "failed";
+}
+
+bool LpSolveOptions::IsValid(std::string* error) const {
+  if (!(primal_tolerance > 0 && primal_tolerance < 1e-3) || !(dual_tolerance > 0 && dual_tolerance < 1e-3)) {
+    if (error) *error = "LP tolerances must lie in (0, 1e-3)";
+    return false;
+  }
+  if (!(time_limit_seconds > 0)) {
+    if (error) *error = "the LP time limit must be positive";
+    return false;
+  }
+  return true;
+}
+
+std::vector<std::string> AvailableLpSolvers() { return {"clp"}; }
+
+bool ValidLpSolverName(const std::string& name, std::string* error) {
+  const auto names = AvailableLpSolvers();
+  if (std::find(names.begin(), names.end(), name) != names.end()) return true;
+  if (error) *error = fmt::format("LP solver '{}' unknown; expected one of: {}", name, fmt::join(names, ", "));
+  return false;
+}
+
+std::unique_ptr<LpSolver> MakeLpSolver(const std::string& name) {
+  std::string error;
+  if (!ValidLpSolverName(name, &error)) throw std::invalid_argument(error);
+  return std::make_unique<ClpSolver>();
+}
+
+}  // namespace hw::exact
