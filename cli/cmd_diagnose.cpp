@@ -14,7 +14,7 @@ namespace {
 struct Opts {
   std::string data, validate, model, fit, out, effects, state_variable = "position";
   diagnose::ColumnNames ident_cols, valid_cols;
-  bool no_pairs = false, no_initial_state = false;
+  bool no_pairs = false, no_initial_state = false, keep_operating_point = false, no_richer = false;
   diagnose::DiagnoseOptions o;
 };
 
@@ -26,6 +26,8 @@ void Run(const Opts& p, bool t_named, bool valid_t_named) {
   if (!p.effects.empty()) o.candidates = diagnose::ParseCandidates(p.effects);
   o.state_variable = diagnose::ParseStateVariable(p.state_variable);
   o.try_pairs = !p.no_pairs;
+  o.remove_operating_point = !p.keep_operating_point;
+  o.richer_nominal = !p.no_richer;
   o.refit.estimate_initial_state = !p.no_initial_state;
   o.nominal_fit.refit.estimate_initial_state = !p.no_initial_state;
   if (!o.IsValid(&err)) throw InputError("diagnose: " + err);
@@ -46,8 +48,7 @@ void Run(const Opts& p, bool t_named, bool valid_t_named) {
   const auto ident = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.data, ic));
   const auto valid = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.validate, vc));
   if (spec) {
-    const diagnose::NominalFit fit =
-        diagnose::FitNominal(*spec, {&ident.u, &ident.y, o.init_samples, 0}, o.nominal_fit);
+    const diagnose::NominalFit fit = diagnose::FitNominalForDiagnosis(*spec, ident, o);
     fmt::print("{}\n", fit.Summary());
     nominal = fit.model;
   }
@@ -101,6 +102,10 @@ void AddDiagnoseCommand(CLI::App& app) {
   cmd->add_option("--state-variable", p->state_variable,
                   "what the linear block's output is: position or velocity (force -> velocity drives)");
   cmd->add_flag("--no-pairs", p->no_pairs, "do not try combinations of two blocks");
+  cmd->add_flag("--keep-operating-point", p->keep_operating_point,
+                "diagnose u and y as recorded even when they lie far from 0 (default: in deviations from their medians)");
+  cmd->add_flag("--no-richer-nominal", p->no_richer,
+                "do not require an effect to beat a richer nominal structure (orders + 1, map degrees + 2)");
   cmd->add_option("--threads", p->o.threads, "parallel candidate fits (0 = all cores)");
   cmd->callback([p, cmd, tc, vu, vy, vt] {
     // Validation columns default to the identification ones unless named.

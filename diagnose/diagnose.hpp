@@ -38,6 +38,40 @@
 
 namespace hw::diagnose {
 
+// What the baseline (the nominal refitted alone) reaches on the held-out tail against the noise.
+enum class NominalStatus {
+  kReachedNoiseFloor,  // held-out RMSE <= noise_floor_factor x noise
+  kExplainedByEffect,  // above it, and the verdict explains at least half of the excess mean square
+  kFailed,             // above it and nothing explains it: no effect verdict is given
+};
+std::string NominalStatusName(NominalStatus s);  // "reached_noise_floor", "explained_by_effect", "failed"
+
+// Recordings made around an operating point far from 0 are diagnosed in deviations u - u_op, y - y_op
+// (u_op, y_op = the identification recording's medians), so that effects acting around the operating
+// point (a dead band, a relay) are found there and polynomial maps stay well conditioned.
+struct OperatingPoint {
+  bool u_removed = false, y_removed = false;
+  double u = 0.0, y = 0.0;
+  // Far from 0: the signal stays on one side of 0 (1 % and 99 % quantiles) and its median is more than
+  // twice its 1-99 % spread away from 0 (a tank level between 1 and 10 V is not: its 0 is physical).
+  static OperatingPoint Of(const Recording& ident);
+  Recording Centred(const Recording& r) const;
+  nlohmann::json to_json() const;
+};
+
+// Feedback: does the input depend on past output residuals? A Granger test: u_t regressed on its own
+// past (lags 1..L) with and without the residual's past (lags 1..L), the 10 % largest innovations of u
+// left out; the F statistic x L is compared with the chi^2_L quantile at 1 - 1e-5. In closed loop the
+// noise reaches the input; the diagnosis still simulates from the recorded input (output error stays
+// consistent with white noise), and says so.
+struct FeedbackTest {
+  bool detected = false;
+  double statistic = 0.0, threshold = 0.0;
+  int lags = 0;
+  nlohmann::json to_json() const;
+};
+FeedbackTest DetectFeedback(const std::vector<double>& u, const std::vector<double>& e, std::size_t skip, int lags);
+
 struct DiagnoseOptions {
   double noise_std = 0.0;             // 0 = estimate from the residuals
   std::size_t init_samples = 0;       // leading samples excluded from every cost (warm-up)
@@ -54,6 +88,10 @@ struct DiagnoseOptions {
   RefitOptions refit;
   NominalFitOptions nominal_fit;      // fresh starts of the baseline (when the structure is known)
   std::vector<std::pair<Effect, Location>> candidates;  // empty = CandidateEffects()
+  bool remove_operating_point = true;  // diagnose in deviations when the recording is far from 0
+  bool richer_nominal = true;          // an effect must also beat a richer nominal (orders + 1, map degrees + 2)
+  double noise_floor_factor = 1.2;     // the baseline reached the noise when its held-out RMSE <= this x noise
+  int feedback_lags = 10;
   bool IsValid(std::string* error) const;
 };
 
@@ -74,7 +112,9 @@ struct Finding {
   int extra_parameters = 0;
   Comparison holdout, validation;
   double score = 0.0;        // combined: 1 - sqrt(penalised ratio held-out x penalised ratio validation)
-  bool eligible = false;     // significant on both
+  bool eligible = false;     // significant on both, better than the richer nominal, physically meaningful
+  bool beats_richer = true;  // held-out score above the richer nominal's
+  bool meaningful = true;    // parameters describe a physical device (no dead band covering the signal)
   double in_window_share = 0.0;  // share of the held-out error reduction inside the residual windows
   std::string evidence;
   std::string Label() const;
@@ -99,6 +139,12 @@ struct DiagnoseReport {
   std::vector<NominalStart> baseline_starts;
   double noise_std = 0.0;
   bool noise_estimated = true;
+  NominalStatus nominal_status = NominalStatus::kReachedNoiseFloor;
+  double baseline_holdout_rmse = 0.0;  // of the baseline, on the held-out tail
+  std::string nominal_status_note;
+  std::string richer_note;             // the richer nominal every effect had to beat, and its score
+  OperatingPoint operating_point;
+  FeedbackTest feedback;               // on the identification recording, from the best model's residual
   // Locate: where the verdict's blocks change the prediction (identification recording), or, without
   // a verdict, where the nominal residual exceeds the noise.
   std::string mask_source;
@@ -132,6 +178,9 @@ bool ValidNominalChoice(bool has_model, bool has_fit, std::string* error);
 // fresh starts. Returns report->ok = false with a message when the inputs cannot be diagnosed.
 void Diagnose(const DiagnoseOptions& options, const AugmentedModel& nominal, const NominalSpec* structure,
               const Recording& ident, const Recording& valid, DiagnoseReport* report);
+
+// Fits `spec` as Diagnose sees the recording (operating point removed when options say so), e.g. for --fit.
+NominalFit FitNominalForDiagnosis(const NominalSpec& spec, const Recording& ident, const DiagnoseOptions& options);
 
 // report.json content (schema in docs/diagnose.md).
 nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const Recording& valid);

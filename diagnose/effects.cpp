@@ -23,11 +23,11 @@ struct EffectInfo {
 const std::vector<EffectInfo>& Infos() {
   static const std::vector<EffectInfo> infos = {
       {Effect::kBacklash, "backlash", {"half_width"}},
-      {Effect::kDeadzone, "deadzone", {"half_width"}},
+      {Effect::kDeadzone, "deadzone", {"half_width", "centre"}},
       {Effect::kSaturation, "saturation", {"lower", "upper"}},
       {Effect::kRateLimit, "rate_limit", {"max_step"}},
       {Effect::kDelay, "delay", {"samples"}},
-      {Effect::kQuantization, "quantization", {"step"}},
+      {Effect::kQuantization, "quantization", {"step", "offset"}},
       {Effect::kCoulombFriction, "coulomb_friction", {"level_up", "level_down"}},
       {Effect::kHysteresis, "hysteresis", {"threshold", "height"}},
       {Effect::kCubicStiffness, "cubic_stiffness", {"k3"}},
@@ -216,8 +216,10 @@ bool EffectBlock::IsValid(std::string* error) const {
   const std::string n = EffectName(effect);
   switch (effect) {
     case Effect::kBacklash:
-    case Effect::kDeadzone:
       if (params[0] < 0) return fail(n + ": half_width must be >= 0");
+      break;
+    case Effect::kDeadzone:
+      if (params[0] < 0 || !std::isfinite(params[1])) return fail(n + ": half_width must be >= 0 and centre finite");
       break;
     case Effect::kRateLimit:
       if (!(params[0] > 0)) return fail("rate_limit: max_step must be > 0");
@@ -226,7 +228,7 @@ bool EffectBlock::IsValid(std::string* error) const {
       if (params[0] < 1 || params[0] != std::round(params[0])) return fail("delay: samples must be an integer >= 1");
       break;
     case Effect::kQuantization:
-      if (!(params[0] > 0)) return fail("quantization: step must be > 0");
+      if (!(params[0] > 0) || !std::isfinite(params[1])) return fail("quantization: step must be > 0 and offset finite");
       break;
     case Effect::kSaturation:
     case Effect::kStateSaturation:
@@ -276,6 +278,12 @@ EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
     RequireKnownKeys(ps, std::set<std::string>(names.begin(), names.end()),
                      fmt::format("effect block {} parameters", EffectName(b.effect)));
     for (const auto& n : names) {
+      if (((b.effect == Effect::kQuantization && std::string(n) == "offset") ||
+           (b.effect == Effect::kDeadzone && std::string(n) == "centre")) &&
+          !ps.contains(n)) {
+        b.params.push_back(0.0);  // models written before the grid offset and the band's centre existed
+        continue;
+      }
       const auto& v = ps.at(n);
       if (v.is_string()) {
         const auto s = v.get<std::string>();
@@ -296,12 +304,18 @@ EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
 
 double ApplyStaticBlock(const EffectBlock& block, double v) {
   switch (block.effect) {
-    case Effect::kDeadzone:
-      return Sign(v) * std::max(std::abs(v) - block.params[0], 0.0);
+    case Effect::kDeadzone: {
+      // A dead band of half-width d around c (0 unless the band sits at an operating point).
+      const double c = block.params.size() > 1 ? block.params[1] : 0.0;
+      return c + Sign(v - c) * std::max(std::abs(v - c) - block.params[0], 0.0);
+    }
     case Effect::kSaturation:
       return std::clamp(v, block.params[0], block.params[1]);
-    case Effect::kQuantization:
-      return block.params[0] * std::round(v / block.params[0]);
+    case Effect::kQuantization: {
+      // Levels offset + k step: the grid of a quantizer need not pass through the recording's 0.
+      const double o = block.params.size() > 1 ? block.params[1] : 0.0;
+      return o + block.params[0] * std::round((v - o) / block.params[0]);
+    }
     default:
       return v;
   }

@@ -13,11 +13,11 @@
 //
 // Effect blocks (parameters in the order of EffectBlock::params, physical ranges in brackets):
 //   backlash@input        [w >= 0]      play operator of half-width w: x_t = clamp(x_{t-1}, u_t - w, u_t + w)
-//   deadzone@input|output [d >= 0]      v -> sign(v) max(|v| - d, 0)
+//   deadzone@input|output [d >= 0, c]   v -> c + sign(v - c) max(|v - c| - d, 0)  (band around c; c optional in JSON, 0)
 //   saturation@input|output [lo < hi]   v -> clamp(v, lo, hi) (either limit may be infinite)
 //   rate_limit@input      [r > 0]       x_t = x_{t-1} + clamp(u_t - x_{t-1}, -r, r)
 //   delay@input           [k >= 1]      dead time: x_t = u_{t-k}, extra to the model's delay (integer)
-//   quantization@input|output [q > 0]   v -> q round(v / q)
+//   quantization@input|output [q > 0, o]  v -> o + q round((v - o) / q)  (levels o + k q; o optional in JSON, 0)
 //   hysteresis@input      [beta >= 0, h >= 0]  x_t = u_t + h s_t, relay s_t = +1 if u_t > beta, -1 if u_t < -beta
 //   stiction@input        [fs >= fd >= 0]  stick-slip of a control valve (He et al. 2007): a stuck stem
 //                                        moves only once |u_t - x_{t-1}| > fs, then follows u at lag fd

@@ -255,10 +255,15 @@ NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const Nomina
   out.spec = spec.Text();
   using Tried = std::vector<std::pair<NominalStart, AugmentedModel>>;
   // A start that ends with a map folding back over the data is not a physical nominal: not kept.
+  Tried folded;  // finite starts whose maps fold back: kept only when no start has monotone maps
   auto attempt = [&](Tried* tried, const std::string& name, const AugmentedModel& start) {
     RefitResult r = RefitModel(start, fit, o.refit);
     const double f = Rmse(r.model, fit), h = Rmse(r.model, held);
-    if (std::isfinite(f) && std::isfinite(h) && MapsMonotone(r.model, *data.u)) tried->push_back({{name, f, h}, r.model});
+    if (!std::isfinite(f) || !std::isfinite(h)) return;
+    if (MapsMonotone(r.model, *data.u))
+      tried->push_back({{name, f, h}, r.model});
+    else
+      folded.push_back({{name + " (maps fold back over the data)", f, h}, r.model});
   };
   auto best_of = [](const Tried& tried) {
     int best = -1;
@@ -292,6 +297,7 @@ NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const Nomina
       attempt(&tried, fmt::format("random maps {}", i + 1), m);
     }
   }
+  if (tried.empty()) tried = folded;  // better a folded map, said so in its name, than no nominal at all
   out.chosen = best_of(tried);
   if (out.chosen < 0) throw InputError(fmt::format("nominal fit {}: no start gave a finite simulation with monotone maps", spec.Text()));
   for (const auto& t : tried) out.starts.push_back(t.first);

@@ -215,6 +215,23 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
   return true;
 }
 
+// ARX poles at the model's delay plus a delay block's dead time, on the input as the model's input map
+// sees it; then the numerator, offset and initial state by least squares.
+bool FreshPolesForDelay(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  const int na = static_cast<int>(m->nominal.linear.a.size()), nb = static_cast<int>(m->nominal.linear.b.size());
+  if (na == 0) return false;
+  Vec x = *s.u;
+  for (const auto& b : m->blocks)
+    if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
+  for (auto& v : x) v = m->nominal.input(v);
+  Vec a, b;
+  double c = 0.0;
+  if (!FitArx(x, *s.y, na, nb, m->nominal.linear.delay, s.skip, s.End(), true, &a, &b, &c)) return false;
+  m->nominal.linear.a = StabilisedDenominator(a);
+  m->nominal.linear.b = b;
+  return SolveNumerator(m, s, o);
+}
+
 // Grid of the new block's parameters, scaled to the recording and to the current simulation.
 std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, const Vec& zhat, const HwModel& nominal) {
   std::vector<Vec> g;
@@ -232,8 +249,9 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
         for (double r : {0.0, 0.3, 0.6, 0.9}) g.push_back({fs, r * fs});
       break;
     case Effect::kDeadzone: {
-      // Around the signal's own zero: deadzones act on the signal's magnitude.
-      for (double d : LogSpace(2e-3 * vmax, 0.6 * vmax, 36)) g.push_back({d});
+      // Around the signal's own zero, or near it (a band at an operating point; LM refines the centre).
+      for (double d : LogSpace(2e-3 * vmax, 0.6 * vmax, 36))
+        for (double c : {0.0, -0.1, 0.1, -0.25, 0.25}) g.push_back({d, c * vmax});
       break;
     }
     case Effect::kSaturation:
@@ -263,7 +281,10 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
       break;
     }
     case Effect::kQuantization:
-      for (double q : LogSpace(1e-3 * range, 0.3 * range, 160)) g.push_back({q});
+      // A quantizer with R / q levels over the range R needs q to within about q / (2R): steps 1 % apart
+      // over the useful range, each with a few grid offsets (refined by the local search).
+      for (double q : LogSpace(3e-3 * range, 0.3 * range, 460))
+        for (double o : {0.0, 0.25, 0.5, 0.75}) g.push_back({q, o * q});
       break;
     case Effect::kHysteresis: {
       Vec au;
@@ -299,8 +320,18 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
 }
 
 // Finer search around a value for parameters that only a search can move.
-Vec LocalValues(Effect e, double v) {
+Vec LocalValues(const EffectBlock& b, int index) {
+  const Effect e = b.effect;
+  const double v = b.params[index];
   Vec out;
+  if (e == Effect::kQuantization && index == 1) {  // grid offset: within one step
+    for (int k = -10; k <= 10; ++k) out.push_back(v + b.params[0] * k / 20.0);
+    return out;
+  }
+  if (e == Effect::kQuantization) {  // step: 0.2 % apart within +-10 %
+    for (int k = -50; k <= 50; ++k) out.push_back(v * (1.0 + 0.002 * k));
+    return out;
+  }
   if (e == Effect::kDelay) {
     for (int k = -2; k <= 2; ++k)
       if (v + k >= 1) out.push_back(v + k);
@@ -321,7 +352,7 @@ void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOption
       any = true;
       double best = SumSquaredError(*m, s);
       AugmentedModel best_m = *m;
-      for (double v : LocalValues(m->blocks[b].effect, m->blocks[b].params[i])) {
+      for (double v : LocalValues(m->blocks[b], static_cast<int>(i))) {
         AugmentedModel t = *m;
         t.blocks[b].params[i] = v;
         std::string err;
@@ -343,7 +374,10 @@ RefitResult Finish(const AugmentedModel& m, const Segment& s) {
   return r;
 }
 
-Vec PolyFromRoots(const std::vector<std::complex<double>>& roots) {
+
+}  // namespace
+
+Vec DenominatorFromRoots(const std::vector<std::complex<double>>& roots) {
   std::vector<std::complex<double>> c = {1.0};
   for (const auto& r : roots) {
     std::vector<std::complex<double>> n(c.size() + 1, 0.0);
@@ -357,8 +391,6 @@ Vec PolyFromRoots(const std::vector<std::complex<double>>& roots) {
   for (std::size_t i = 1; i < c.size(); ++i) a.push_back(c[i].real());
   return a;
 }
-
-}  // namespace
 
 bool LmOptions::IsValid(std::string* error) const {
   if (max_iterations < 0 || !(relative_tolerance > 0)) {
@@ -473,7 +505,7 @@ Vec StabilisedDenominator(const Vec& a) {
     }
     roots.push_back(r);
   }
-  return changed ? PolyFromRoots(roots) : a;
+  return changed ? DenominatorFromRoots(roots) : a;
 }
 
 bool FitArx(const Vec& x, const Vec& y, int na, int nb, int d, std::size_t skip, std::size_t end, bool with_constant,
@@ -557,6 +589,15 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     if (!b.IsValid(&err)) continue;
     m.blocks.push_back(b);
     if (o.estimate_initial_state) m.initial_state.resize(m.nominal.linear.a.size(), 0.0);
+    if (effect == Effect::kDelay) {
+      // A dead time is a change of the nominal's own structure: its poles are re-estimated from the
+      // data at every candidate delay (ARX), not held at values that absorbed part of the delay.
+      AugmentedModel fresh = m;
+      if (FreshPolesForDelay(&fresh, s, o)) {
+        const double cf = SumSquaredError(fresh, s);
+        if (std::isfinite(cf)) scored.emplace_back(cf, fresh);
+      }
+    }
     SolveNumerator(&m, s, o);
     const double c = SumSquaredError(m, s);
     if (std::isfinite(c)) scored.emplace_back(c, m);

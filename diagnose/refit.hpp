@@ -9,6 +9,7 @@
 // Levenberg–Marquardt on the simulation error, with forward-difference Jacobians. Search-only
 // parameters (integer delay, quantisation step, relay threshold) are refined by a finer local grid.
 // Every step keeps the block parameters in their physical range (ClampToPhysicalRange).
+#include <complex>
 #include <functional>
 #include <string>
 #include <vector>
@@ -79,6 +80,8 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
 // has no poles or when `options.estimate_initial_state` is false.
 void EstimateInitialState(AugmentedModel* model, const Segment& data, const RefitOptions& options);
 
+// a_1..a_n of A(q) = prod (1 - r q^-1) over the roots r (complex roots in conjugate pairs).
+std::vector<double> DenominatorFromRoots(const std::vector<std::complex<double>>& roots);
 // Reflects roots of A(q) outside the unit circle inside it (keeps the model simulable).
 std::vector<double> StabilisedDenominator(const std::vector<double>& a);
 

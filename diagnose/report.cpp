@@ -124,7 +124,13 @@ nlohmann::json ReportJson(const DiagnoseReport& r, const Recording& ident, const
   j["verdict_blocks"] = verdict_blocks;
   j["summary"] = r.message;
   j["baseline"] = {{"source", r.baseline_source}, {"starts", StartsJson(r.baseline_starts)},
-                   {"initial_state", r.initial_state_note}};
+                   {"initial_state", r.initial_state_note},
+                   {"holdout_rmse", r.baseline_holdout_rmse},
+                   {"nominal_status", NominalStatusName(r.nominal_status)},
+                   {"nominal_status_note", r.nominal_status_note},
+                   {"richer_nominal", r.richer_note}};
+  j["operating_point"] = r.operating_point.to_json();
+  j["feedback"] = r.feedback.to_json();
   j["findings"] = FindingsJson(r.findings);
   j["pairs"] = FindingsJson(r.pairs);
   j["mismatch"] = {

@@ -124,7 +124,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
         case Effect::kBacklash:
           return {o.effect, loc, {s * 0.3 * range}};
         case Effect::kDeadzone:
-          return {o.effect, loc, {s * 0.6 * vmax}};
+          return {o.effect, loc, {s * 0.6 * vmax, 0.0}};
         case Effect::kSaturation:
         case Effect::kStateSaturation: {
           const double q = std::max(1e-4, 0.35 * s);
@@ -136,7 +136,7 @@ Scenario MakeScenario(const ScenarioOptions& o) {
         case Effect::kDelay:
           return {o.effect, loc, {double(k_delay)}};
         case Effect::kQuantization:
-          return {o.effect, loc, {std::max(1e-6, s * 0.5 * range)}};
+          return {o.effect, loc, {std::max(1e-6, s * 0.5 * range), 0.0}};
         case Effect::kHysteresis:
           return {o.effect, loc, {beta, s * 0.5 * StdDev(u_id)}};
         case Effect::kStiction:

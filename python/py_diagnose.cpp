@@ -53,7 +53,7 @@ py::object Diagnose(py::handle ident_arg, py::handle valid_arg, py::handle model
   } else {
     const auto spec = diagnose::NominalSpec::Parse(fit.cast<std::string>());
     WithoutGil([&] {
-      const diagnose::NominalFit nominal = diagnose::FitNominal(spec, {&ident.u, &ident.y, o.init_samples, 0}, o.nominal_fit);
+      const diagnose::NominalFit nominal = diagnose::FitNominalForDiagnosis(spec, ident, o);
       diagnose::Diagnose(o, nominal.model, &spec, ident, valid, &report);
       return 0;
     });
@@ -74,7 +74,8 @@ void DefineDiagnose(py::module_& m) {
          std::size_t init_samples, double holdout_fraction, double significance_z, double min_improvement,
          double validation_z, bool try_pairs, int pair_partners, int max_lag, int threads,
          const std::string& state_variable, int window_length, double window_alpha, bool refit_maps,
-         bool fit_output_offset, bool estimate_initial_state, int keep_grid_points, py::handle out_dir) {
+         bool fit_output_offset, bool estimate_initial_state, int keep_grid_points, bool remove_operating_point,
+         bool richer_nominal, py::handle out_dir) {
         diagnose::DiagnoseOptions o;
         o.noise_std = noise_std;
         o.init_samples = init_samples;
@@ -94,6 +95,8 @@ void DefineDiagnose(py::module_& m) {
         o.refit.estimate_initial_state = estimate_initial_state;
         o.nominal_fit.refit.estimate_initial_state = estimate_initial_state;
         o.refit.keep_grid_points = keep_grid_points;
+        o.remove_operating_point = remove_operating_point;
+        o.richer_nominal = richer_nominal;
         return Diagnose(ident, valid, model, fit, effects, o, out_dir);
       },
       R"doc(Discrepancy diagnosis (docs/diagnose.md), as `hwbounds diagnose`: where the nominal model's
@@ -113,7 +116,8 @@ the CLI's report files there. Returns report.json as a dict.)doc",
       py::arg("window_length") = d.windows.length, py::arg("window_alpha") = d.windows.alpha,
       py::arg("refit_maps") = d.refit.refit_maps, py::arg("fit_output_offset") = d.refit.fit_output_offset,
       py::arg("estimate_initial_state") = d.refit.estimate_initial_state,
-      py::arg("keep_grid_points") = d.refit.keep_grid_points, py::arg("out_dir") = py::none());
+      py::arg("keep_grid_points") = d.refit.keep_grid_points, py::arg("remove_operating_point") = d.remove_operating_point,
+      py::arg("richer_nominal") = d.richer_nominal, py::arg("out_dir") = py::none());
 
   const diagnose::ScenarioOptions s;
   m.def(
