@@ -8,7 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include "relax/moment_relaxation.hpp"
+#include "pop/moment_relaxation.hpp"
 
 namespace {
 
@@ -20,9 +20,9 @@ double median(std::vector<double> v) {
 }
 
 // Random dense quartic over the unit ball: min f s.t. 1 - |x|^2 >= 0.
-hw::relax::PolyProblem RandomProblem(int n, std::mt19937& rng) {
+hw::pop::PolyProblem RandomProblem(int n, std::mt19937& rng) {
   std::normal_distribution<double> g;
-  hw::relax::PolyProblem p;
+  hw::pop::PolyProblem p;
   p.num_vars = n;
   p.objective = hw::Polynomial(n);
   hw::MonomialBasis basis(n, 4);
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
       std::size_t moments = 0, nnz = 0;
       for (int r = 0; r < repeats; ++r) {
         const auto t0 = Clock::now();
-        hw::relax::MomentRelaxation relaxation(problem, order);
+        hw::pop::MomentRelaxation relaxation(problem, order);
         build.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         moments = relaxation.lmi().c.size();
         nnz = relaxation.lmi().nonzeros();

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Peak resident memory of single moment relaxations (GNU time's %M), the measurements behind the memory model
-# of relax/relaxation_size.hpp (tests/relaxation_size_test.cpp holds the figures minus the order-1 process).
+# of pop/relaxation_size.hpp (tests/relaxation_size_test.cpp holds the figures minus the order-1 process).
 # Usage: benchmarks/relaxation_memory.sh [build-dir]   (about 15 minutes; needs /usr/bin/time)
 set -euo pipefail
 BUILD=${1:-build}

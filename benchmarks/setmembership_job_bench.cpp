@@ -9,9 +9,9 @@
 #include <fmt/format.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/moment_lp.hpp"
-#include "relax/hw_outer_set.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_lp.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace {
@@ -56,23 +56,23 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   const auto ex = hw::SimulateCeroneExample(1, samples, snr_db);
-  hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+  hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
   std::vector<std::pair<double, double>> boxes(8, {-box, box});
   if (box_list.size() == 16)
     for (int i = 0; i < 8; ++i) boxes[i] = {box_list[2 * i], box_list[2 * i + 1]};
   const int l = orthant >= 0 ? orthant
-                             : hw::relax::HwOuterSet(hw::relax::CeroneExampleStructure(), data, horizon, boxes)
+                             : hw::dss::HwOuterSet(hw::dss::CeroneExampleStructure(), data, horizon, boxes)
                                    .orthant_of(hw::CeroneExample::TrueParameters());
   for (int round = 1; round <= contract_rounds; ++round) {
-    hw::relax::HwOuterSet s(hw::relax::CeroneExampleStructure(), data, horizon, boxes);
+    hw::dss::HwOuterSet s(hw::dss::CeroneExampleStructure(), data, horizon, boxes);
     std::vector<hw::Polynomial> cons = s.sign_constraints(l);
     for (auto& c : s.data_constraints(l)) cons.push_back(c.g);
     const auto tc = Clock::now();
     auto lp_solver = hw::sdp::MakeSolver(solver_name);
     fmt::print("LP contraction round {}:", round);
     for (int i = 0; i < 8; ++i) {
-      const auto lo = hw::relax::LinearProgramBound(cons, 8, i, -1, {}, *lp_solver);
-      const auto hi = hw::relax::LinearProgramBound(cons, 8, i, +1, {}, *lp_solver);
+      const auto lo = hw::pop::LinearProgramBound(cons, 8, i, -1, {}, *lp_solver);
+      const auto hi = hw::pop::LinearProgramBound(cons, 8, i, +1, {}, *lp_solver);
       const double nlo = lo.status == lo.kBounded ? s.scaling().to_original(i, lo.bound) : boxes[i].first;
       const double nhi = hi.status == hi.kBounded ? s.scaling().to_original(i, hi.bound) : boxes[i].second;
       boxes[i] = {std::max(boxes[i].first, nlo), std::min(boxes[i].second, nhi)};
@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
     }
     fmt::print("  ({:.2f} s)\n", since(tc));
   }
-  hw::relax::HwOuterSet set(hw::relax::CeroneExampleStructure(), data, horizon, boxes);
+  hw::dss::HwOuterSet set(hw::dss::CeroneExampleStructure(), data, horizon, boxes);
   const auto& names = set.layout().names;
   const int k = static_cast<int>(std::find(names.begin(), names.end(), param) - names.begin());
   if (k >= set.num_vars()) {
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   }
   std::vector<hw::Polynomial> candidates;
   for (auto& c : set.data_constraints(l)) candidates.push_back(std::move(c.g));
-  hw::relax::PolyProblem core;
+  hw::pop::PolyProblem core;
   core.num_vars = set.num_vars();
   core.objective = hw::Polynomial::Variable(core.num_vars, k);
   core.maximize = maximize;
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
     }
   }
   for (auto& g : set.sign_constraints(l)) core.inequalities.push_back(g);
-  hw::relax::ConstraintGenerationOptions gen;
+  hw::pop::ConstraintGenerationOptions gen;
   gen.order = order;
   gen.add_per_round = add;
   gen.verify.enabled = verify;
@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     auto cheap = gen;
     cheap.order = start_order;
     const auto tc = Clock::now();
-    const auto c = hw::relax::SolveWithConstraintGeneration(cheap, core, candidates, {}, *solver);
+    const auto c = hw::pop::SolveWithConstraintGeneration(cheap, core, candidates, {}, *solver);
     initial = c.active_set.empty() ? c.working_set : c.active_set;
     fmt::print("order {} first: bound {:.8f} in {} rounds, {:.2f} s; {} active rows start the order-{} job\n",
                start_order, c.bound, c.rounds, since(tc), initial.size(), order);
@@ -132,14 +132,14 @@ int main(int argc, char** argv) {
   fmt::print("{:>5} {:>5} {:>9} {:>9}\n", "round", "K", "elapsed", "");
   const auto t0 = Clock::now();
   int round = 0;
-  const auto r = hw::relax::SolveWithConstraintGeneration(
-      gen, core, candidates, initial, *solver, [&](const hw::relax::GenerationRound& r) {
+  const auto r = hw::pop::SolveWithConstraintGeneration(
+      gen, core, candidates, initial, *solver, [&](const hw::pop::GenerationRound& r) {
         fmt::print("{:>5} {:>5} {:>9.2f}  {} bound {:.8f}\n", ++round, r.blocks, since(t0), r.status, r.bound);
         std::fflush(stdout);
       });
   fmt::print("status {} bound {:.6f} (original units {:.6f}) tight {} rounds {} iterations {} solver {:.2f} s of "
              "{:.2f} s wall\n{}\nlast SDP: {}\n",
-             hw::relax::ToString(r.status), r.bound, set.scaling().to_original(k, r.bound), r.tight, r.rounds,
+             hw::pop::ToString(r.status), r.bound, set.scaling().to_original(k, r.bound), r.tight, r.rounds,
              r.sdp_iterations, r.solve_seconds, since(t0), r.message, r.last_sdp.message);
   return 0;
 }

@@ -9,19 +9,19 @@
 #include <fmt/format.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/row_reduction.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "dss/row_reduction.hpp"
+#include "pop/constraint_generation.hpp"
 
 namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 // Where a bound comes from, in scaled units: the solver's float bound, the verified one, and the generation's check.
-void PrintDetails(const char* what, const hw::relax::ConstraintGenerationResult& r) {
+void PrintDetails(const char* what, const hw::pop::ConstraintGenerationResult& r) {
   fmt::print("  {}: bound {:.9f} float {:.9f} primal {:.9f} verified {} origin {} round {} unfinished {} tight {} "
              "max violation {:.2e} rounds {} status {}\n",
-             what, r.bound, r.float_bound, r.primal_value, r.verification.verified(), hw::relax::ToString(r.origin),
+             what, r.bound, r.float_bound, r.primal_value, r.verification.verified(), hw::pop::ToString(r.origin),
              r.bound_round, r.bound_from_unfinished_solve, r.tight, r.max_violation, r.rounds, r.last_sdp.message);
 }
 }  // namespace
@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   double snr = 31.0;
   std::string solver_name = "sdpa";
   bool skip_dense = false, details = false;
-  double violation_tolerance = hw::relax::ConstraintGenerationOptions{}.violation_tolerance;
+  double violation_tolerance = hw::pop::ConstraintGenerationOptions{}.violation_tolerance;
   double gap = 1e-5;
   app.add_option("--samples", samples)->delimiter(',');
   app.add_option("--params", params)->delimiter(',');
@@ -52,8 +52,8 @@ int main(int argc, char** argv) {
              "dense s", "engine bound", "engine s", "ratio", "rel diff", "blocks", "rounds");
   for (int N : samples) {
     const auto ex = hw::SimulateCeroneExample(seed, N, snr);
-    hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
-    hw::relax::HwOuterSet set(hw::relax::CeroneExampleStructure(), data, horizon,
+    hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+    hw::dss::HwOuterSet set(hw::dss::CeroneExampleStructure(), data, horizon,
                               std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
     const int l = set.orthant_of(hw::CeroneExample::TrueParameters());
     const auto rows = set.data_constraints(l);
@@ -68,12 +68,12 @@ int main(int argc, char** argv) {
       const int k = static_cast<int>(std::find(set.layout().names.begin(), set.layout().names.end(), name) -
                                      set.layout().names.begin());
       for (int dir : {-1, +1}) {
-        hw::relax::PolyProblem core;
+        hw::pop::PolyProblem core;
         core.num_vars = set.num_vars();
         core.objective = hw::Polynomial::Variable(set.num_vars(), k);
         core.maximize = dir > 0;
         core.inequalities = fixed;
-        hw::relax::ConstraintGenerationOptions gen;
+        hw::pop::ConstraintGenerationOptions gen;
         gen.order = order;
         gen.violation_tolerance = violation_tolerance;
         gen.sdp.acceptable_gap = gap;
@@ -85,19 +85,19 @@ int main(int argc, char** argv) {
           auto dense_problem = core;
           for (const auto& g : all) dense_problem.inequalities.push_back(g);
           const auto t0 = Clock::now();
-          const auto d = hw::relax::SolveWithConstraintGeneration(gen, dense_problem, {}, {}, *solver);
+          const auto d = hw::pop::SolveWithConstraintGeneration(gen, dense_problem, {}, {}, *solver);
           dense_s = since(t0);
-          dense_bound = d.status == hw::relax::RelaxationStatus::kSolved ? set.scaling().to_original(k, d.bound) : NAN;
+          dense_bound = d.status == hw::pop::RelaxationStatus::kSolved ? set.scaling().to_original(k, d.bound) : NAN;
           if (details) PrintDetails("dense", d);
         }
         const auto t1 = Clock::now();
-        const auto red = hw::relax::ReduceDataRows({}, all, steps, fixed);
+        const auto red = hw::dss::ReduceDataRows({}, all, steps, fixed);
         std::vector<hw::Polynomial> kept;
         for (int i : red.kept) kept.push_back(all[i]);
-        const auto e = hw::relax::SolveWithConstraintGeneration(gen, core, kept, {}, *solver);
+        const auto e = hw::pop::SolveWithConstraintGeneration(gen, core, kept, {}, *solver);
         const double engine_s = since(t1);
         const double engine_bound =
-            e.status == hw::relax::RelaxationStatus::kSolved ? set.scaling().to_original(k, e.bound) : NAN;
+            e.status == hw::pop::RelaxationStatus::kSolved ? set.scaling().to_original(k, e.bound) : NAN;
         if (details) PrintDetails("engine", e);
         fmt::print("{:>5} {:>7} {:>4} {:>13.7f} {:>9.1f} {:>13.7f} {:>9.1f} {:>8.2f} {:>9.1e} {:>7} {:>6}\n", N, name,
                    dir < 0 ? "min" : "max", dense_bound, dense_s, engine_bound, engine_s, dense_s / engine_s,

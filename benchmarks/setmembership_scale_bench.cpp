@@ -13,11 +13,11 @@
 #include <fmt/format.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
 
 namespace {
 // "kept/rows" per horizon step, summed over the live orthants.
-std::string RowsKept(const hw::relax::BoundsSummary& s) {
+std::string RowsKept(const hw::dss::BoundsSummary& s) {
   std::map<int, std::pair<int, int>> per_step;
   for (const auto& orthant : s.row_reduction)
     for (const auto& step : orthant.at("per_step")) {
@@ -30,7 +30,7 @@ std::string RowsKept(const hw::relax::BoundsSummary& s) {
   return text.empty() ? "-" : text;
 }
 
-void PrintIntervals(const hw::relax::BoundsSummary& s) {
+void PrintIntervals(const hw::dss::BoundsSummary& s) {
   for (const auto& iv : s.intervals)
     fmt::print("         {:<7} [{:.6f}, {:.6f}] {} / {}\n", iv.name, iv.lower.value, iv.upper.value, iv.lower.status,
                iv.upper.status);
@@ -58,20 +58,20 @@ int main(int argc, char** argv) {
   std::map<int, double> wall_1;
   for (int N : samples) {
     const auto ex = hw::SimulateCeroneExample(1, N);
-    hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
-    hw::relax::HwOuterSet set(hw::relax::CeroneExampleStructure(), data, horizon,
+    hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+    hw::dss::HwOuterSet set(hw::dss::CeroneExampleStructure(), data, horizon,
                               std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
     for (int w : workers) {
       std::vector<double> walls;
-      hw::relax::BoundsSummary s;
+      hw::dss::BoundsSummary s;
       for (int r = 0; r < repeats; ++r) {
-        hw::relax::BoundsOptions o;
+        hw::dss::BoundsOptions o;
         o.order = order;
         o.solver = solver;
         o.threads = w;
         o.parameters = params;
         const auto t0 = std::chrono::steady_clock::now();
-        s = hw::relax::ComputeBounds(o, set);
+        s = hw::dss::ComputeBounds(o, set);
         walls.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       }
       std::sort(walls.begin(), walls.end());

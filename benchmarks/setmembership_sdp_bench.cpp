@@ -16,9 +16,9 @@
 #include <fmt/format.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/moment_relaxation.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_relaxation.hpp"
 #include "sdp/verified_bound.hpp"
 
 namespace {
@@ -52,9 +52,9 @@ int main(int argc, char** argv) {
   const auto solver_names = SplitCommas(solvers);
   for (const auto& name : solver_names) hw::sdp::MakeSolver(name);  // unknown names fail before any work
   const auto ex = hw::SimulateCeroneExample(1, samples);
-  const hw::relax::HwStructure s = hw::relax::CeroneExampleStructure();
-  hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
-  hw::relax::HwOuterSet set(s, data, horizon, std::vector<std::pair<double, double>>(8, {-10, 10}));
+  const hw::dss::HwStructure s = hw::dss::CeroneExampleStructure();
+  hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+  hw::dss::HwOuterSet set(s, data, horizon, std::vector<std::pair<double, double>>(8, {-10, 10}));
   const int l = set.orthant_of(hw::CeroneExample::TrueParameters());
   const auto cons = set.data_constraints(l);
   const int a1 = set.layout().a_begin;
@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);  // a run cut short by `timeout` still shows what it was doing
   for (const auto& item : SplitCommas(ks)) {
     const int K = std::min<int>(std::stoi(item), cons.size());
-    hw::relax::PolyProblem p;
+    hw::pop::PolyProblem p;
     p.num_vars = 8;
     p.objective = hw::Polynomial::Variable(8, a1);
     p.inequalities = set.box_constraints();
@@ -72,8 +72,8 @@ int main(int argc, char** argv) {
     // Spread the K constraints over the record.
     for (int k = 0; k < K; ++k) p.inequalities.push_back(cons[static_cast<std::size_t>(k) * cons.size() / K].g);
     const auto t_build = Clock::now();
-    hw::relax::MomentRelaxation r(p, order);
-    const auto bounds = hw::relax::MomentVariableBounds(p, r);
+    hw::pop::MomentRelaxation r(p, order);
+    const auto bounds = hw::pop::MomentVariableBounds(p, r);
     fmt::print("# K={}: {} moments, {} blocks, {} nonzeros, built in {:.2f} s\n", K, r.lmi().c.size(), r.lmi().blocks.size(),
                r.lmi().nonzeros(), std::chrono::duration<double>(Clock::now() - t_build).count());
     std::fflush(stdout);

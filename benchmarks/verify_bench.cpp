@@ -11,9 +11,9 @@
 #include <fmt/format.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/moment_relaxation.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_relaxation.hpp"
 #include "sdp/verified_bound.hpp"
 
 namespace {
@@ -39,8 +39,8 @@ int main(int argc, char** argv) {
   app.add_option("--empty", empty_count, "orthants whose (infeasible) relaxation is solved to time certificates");
   CLI11_PARSE(app, argc, argv);
   const auto ex = hw::SimulateCeroneExample(1, samples);
-  hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
-  hw::relax::HwOuterSet set(hw::relax::CeroneExampleStructure(), data, horizon,
+  hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
+  hw::dss::HwOuterSet set(hw::dss::CeroneExampleStructure(), data, horizon,
                             std::vector<std::pair<double, double>>(8, {-10, 10}));
   const int n = set.num_vars();
   const int truth_orthant = set.orthant_of(hw::CeroneExample::TrueParameters());
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   sdp_options.acceptable_gap = 1e-5;  // as the set-membership engine runs them
 
   auto problem_for = [&](int l, int param, bool maximize) {
-    hw::relax::PolyProblem p;
+    hw::pop::PolyProblem p;
     p.num_vars = n;
     p.objective = hw::Polynomial::Variable(n, param);
     p.maximize = maximize;
@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
     }
     for (bool maximize : {false, true}) {
       const auto p = problem_for(truth_orthant, param, maximize);
-      hw::relax::MomentRelaxation r(p, order);
+      hw::pop::MomentRelaxation r(p, order);
       const auto t0 = Clock::now();
       const auto s = solver->Solve(sdp_options, r.lmi());
       const double ts = since(t0);
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
         fmt::print("{:<12} solve ended {}\n", name + (maximize ? " max" : " min"), hw::sdp::ToString(s.status));
         continue;
       }
-      const auto bounds = hw::relax::MomentVariableBounds(p, r);
+      const auto bounds = hw::pop::MomentVariableBounds(p, r);
       const auto t1 = Clock::now();
       const auto v = hw::sdp::VerifyLowerBound(r.lmi(), s.X, bounds, s.lower_bound);  // the verification alone
       const double tv = since(t1);
@@ -109,14 +109,14 @@ int main(int argc, char** argv) {
   for (int l = 0; l < set.num_orthants() && certificates < empty_count; ++l) {
     if (l == truth_orthant) continue;
     const auto p = problem_for(l, 0, false);
-    hw::relax::MomentRelaxation r(p, order);
+    hw::pop::MomentRelaxation r(p, order);
     const auto t0 = Clock::now();
     const auto s = solver->Solve(sdp_options, r.lmi());
     const double ts = since(t0);
     if (s.status != hw::sdp::SdpStatus::kInfeasible) continue;
     ++certificates;
     const auto t1 = Clock::now();
-    const auto v = hw::sdp::VerifyInfeasibility(r.lmi(), s.X, hw::relax::MomentVariableBounds(p, r));
+    const auto v = hw::sdp::VerifyInfeasibility(r.lmi(), s.X, hw::pop::MomentVariableBounds(p, r));
     const double tv = since(t1);
     inf_solve.push_back(ts);
     inf_verify.push_back(tv);

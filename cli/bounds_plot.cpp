@@ -51,7 +51,7 @@ std::string Quoted(const std::string& text) { return "\"" + text + "\""; }
 
 // One row per interval, the first parameter on top: row, box label, interval label, then positions in the prior
 // box (lower, upper, truth) and within the interval (witnessed lower, witnessed upper, truth).
-std::string IntervalRows(const relax::BoundsSummary& s, const std::vector<double>& truth) {
+std::string IntervalRows(const dss::BoundsSummary& s, const std::vector<double>& truth) {
   std::string rows;
   const int n = static_cast<int>(s.intervals.size());
   for (int r = 0; r < n; ++r) {
@@ -70,7 +70,7 @@ std::string IntervalRows(const relax::BoundsSummary& s, const std::vector<double
 }
 
 // Every certified feasible point, once per plotted parameter: row, position in the box, position in the interval.
-std::string PointRows(const relax::BoundsSummary& s) {
+std::string PointRows(const dss::BoundsSummary& s) {
   std::string rows;
   const int n = static_cast<int>(s.intervals.size());
   for (const auto& p : s.feasible_points)
@@ -84,7 +84,7 @@ std::string PointRows(const relax::BoundsSummary& s) {
   return rows.empty() ? "? ? ?\n" : rows;  // gnuplot refuses an empty file; one missing row draws nothing
 }
 
-std::string Script(const relax::BoundsSummary& s, bool with_truth, const std::string& terminal) {
+std::string Script(const dss::BoundsSummary& s, bool with_truth, const std::string& terminal) {
   const int n = static_cast<int>(s.intervals.size());
   const std::string title =
       s.invalidated() ? "model invalidated: every sign orthant proven empty"
@@ -136,7 +136,7 @@ std::string CheckPlotOutput(const std::string& path) {
   throw InputError("--plot: this gnuplot has no PNG terminal (pngcairo or png); install gnuplot-nox or leave out --plot");
 }
 
-std::string RenderBoundsPlot(const relax::BoundsSummary& summary, const std::vector<double>& truth,
+std::string RenderBoundsPlot(const dss::BoundsSummary& summary, const std::vector<double>& truth,
                              const std::string& terminal) {
   const TempDir dir;
   OutputFiles inputs;

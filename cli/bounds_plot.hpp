@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
 
 namespace hw::cli {
 
@@ -17,7 +17,7 @@ std::string CheckPlotOutput(const std::string& path);
 // The PNG of `summary` (bytes), drawn with `terminal` in a temporary directory that is removed afterwards.
 // `truth` is empty or holds one value per parameter of summary.parameter_names. Throws std::runtime_error
 // with gnuplot's messages when it fails.
-std::string RenderBoundsPlot(const relax::BoundsSummary& summary, const std::vector<double>& truth,
+std::string RenderBoundsPlot(const dss::BoundsSummary& summary, const std::vector<double>& truth,
                              const std::string& terminal);
 
 }  // namespace hw::cli

@@ -15,9 +15,10 @@
 #include "core/recording.hpp"
 #include "exact/exact_bounds.hpp"
 #include "exact/exact_report.hpp"
-#include "relax/bounds_report.hpp"
-#include "relax/box_split.hpp"
-#include "relax/set_membership.hpp"
+#include "exact/two_stage.hpp"
+#include "dss/bounds_report.hpp"
+#include "dss/box_split.hpp"
+#include "dss/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::cli {
@@ -40,7 +41,7 @@ std::vector<std::pair<double, double>> parse_box(const std::vector<std::string>&
     if (!(in >> lo >> comma >> hi) || comma != ',' || !(in >> std::ws).eof())
       throw InputError(fmt::format("--box '{}': expected LO,HI (every parameter) or NAME=LO,HI", spec));
     RequireOption(fmt::format("--box '{}'", spec),
-                  [&](std::string* e) { return relax::ValidBoxEntry(target, lo, hi, names, e); });
+                  [&](std::string* e) { return dss::ValidBoxEntry(target, lo, hi, names, e); });
     for (std::size_t i = 0; i < names.size(); ++i)
       if (target.empty() || names[i] == target) box[i] = {lo, hi};
   }
@@ -65,8 +66,8 @@ std::vector<double> parse_list(const std::string& text, const std::string& what)
 
 // "--split gamma2=0" or "--split a1=1.7,1.8 --split b1=0": the prior box is cut at these values (one entry per
 // parameter). The text's syntax is checked here, the values against the box by the library's ValidBoxCuts.
-std::vector<relax::BoxCut> parse_split(const std::vector<std::string>& specs) {
-  std::vector<relax::BoxCut> cuts;
+std::vector<dss::BoxCut> parse_split(const std::vector<std::string>& specs) {
+  std::vector<dss::BoxCut> cuts;
   for (const auto& spec : specs) {
     const auto eq = spec.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
@@ -88,7 +89,7 @@ struct BoundsCliOptions {
   bool order_given = false, noise_bound_given = false;  // --order, --noise-bound on the command line
   bool proper = false, no_cheap = false, no_edge_witnesses = false, no_moment_witnesses = false, no_full_pass_contraction = false, solver_retry = false, quiet = false, verbose = false, verify = false, no_verify = false;
   int contraction_passes = 0;
-  int stopped_short_refinements = relax::BoundsOptions{}.stopped_short_refinements;
+  int stopped_short_refinements = dss::BoundsOptions{}.stopped_short_refinements;
   int endpoint_refinements = 0;
   int row_block_order = -1;
   int auto_split = 0;
@@ -98,7 +99,7 @@ struct BoundsCliOptions {
 };
 
 // What the bounds of the exact set D need besides the D^ss(n) run: its start box is that run's result.
-exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const relax::BoundsOptions& dss) {
+exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss::BoundsOptions& dss) {
   exact::ExactBoundsOptions options;
   options.executor = dss.executor;
   options.run_dir = o.run_dir;
@@ -110,25 +111,12 @@ exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const rela
   return options;
 }
 
-// The start box of the exact set: the D^ss(n) intervals (valid bounds, also where conservative), the prior box
-// for parameters the run did not bound.
-exact::ParamBox StartBoxFrom(const relax::BoundsSummary& dss, const relax::HwOuterSet& set) {
-  const auto& names = set.layout().names;
-  exact::ParamBox box;
-  for (std::size_t k = 0; k < names.size(); ++k) box.emplace_back(set.box()[k].first, set.box()[k].second);
-  for (const auto& iv : dss.intervals) {
-    const std::size_t k = std::find(names.begin(), names.end(), iv.name) - names.begin();
-    if (k < names.size()) box[k] = exact::Interval(std::max(box[k].lo, iv.lower.value), std::min(box[k].hi, iv.upper.value));
-  }
-  return box;
-}
-
-relax::HwData ReadData(const BoundsCliOptions& o) {
+dss::HwData ReadData(const BoundsCliOptions& o) {
   std::vector<std::string> columns = {o.u_col, o.y_col};
   if (!o.noise_col.empty()) columns.push_back(o.noise_col);
   // A time column (t=VAR, or a CSV column t) is checked and not used: the model runs on the sample index.
   const CsvTable table = read_recording(o.data, columns, {"t"});
-  relax::HwData data;
+  dss::HwData data;
   data.source = o.data;
   data.lines = table.lines;
   data.u = table.column(o.u_col);
@@ -137,16 +125,16 @@ relax::HwData ReadData(const BoundsCliOptions& o) {
     data.noise_bound = table.column(o.noise_col);
   } else {
     if (!o.noise_bound_given) throw InputError("give the noise bound: --noise-bound VALUE or --noise-col COLUMN");
-    RequireOption("--noise-bound", [&](std::string* e) { return relax::ValidNoiseBound(o.noise_bound, e); });
+    RequireOption("--noise-bound", [&](std::string* e) { return dss::ValidNoiseBound(o.noise_bound, e); });
     data.noise_bound.assign(data.y.size(), o.noise_bound);
   }
   return data;
 }
 
-relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
-  relax::HwStructure structure;
-  structure.input_basis = relax::parse_basis(o.input_basis);
-  structure.output_basis = relax::parse_basis(o.output_basis);
+dss::HwStructure ReadStructure(const BoundsCliOptions& o) {
+  dss::HwStructure structure;
+  structure.input_basis = dss::parse_basis(o.input_basis);
+  structure.output_basis = dss::parse_basis(o.output_basis);
   structure.na = o.na;
   structure.nb = o.nb;
   structure.strictly_proper = !o.proper;
@@ -157,33 +145,33 @@ relax::HwStructure ReadStructure(const BoundsCliOptions& o) {
 
 // The option values the library checks (the Python module's checks, with the same messages), before any work.
 void CheckBoundsOptions(const BoundsCliOptions& o) {
-  RequireOption("--horizon", [&](std::string* e) { return relax::ValidHorizon(o.horizon, e); });
-  if (o.order_given) RequireOption("--order", [&](std::string* e) { return relax::ValidOrder(o.order, o.horizon, e); });
-  RequireOption("--solver", [&](std::string* e) { return relax::ValidBoundsSolver(o.solver, e); });
-  RequireOption("--threads", [&](std::string* e) { return relax::ValidThreads(o.threads, e); });
+  RequireOption("--horizon", [&](std::string* e) { return dss::ValidHorizon(o.horizon, e); });
+  if (o.order_given) RequireOption("--order", [&](std::string* e) { return dss::ValidOrder(o.order, o.horizon, e); });
+  RequireOption("--solver", [&](std::string* e) { return dss::ValidBoundsSolver(o.solver, e); });
+  RequireOption("--threads", [&](std::string* e) { return dss::ValidThreads(o.threads, e); });
   RequireOption("--executor", [&](std::string* e) { return sdp::ValidExecutorName(o.executor, e); });
-  RequireOption("--contract-passes", [&](std::string* e) { return relax::ValidContractionPasses(o.contraction_passes, e); });
-  RequireOption("--row-block-order", [&](std::string* e) { return relax::ValidBlockOrderCap(o.row_block_order, e); });
+  RequireOption("--contract-passes", [&](std::string* e) { return dss::ValidContractionPasses(o.contraction_passes, e); });
+  RequireOption("--row-block-order", [&](std::string* e) { return pop::ValidBlockOrderCap(o.row_block_order, e); });
   RequireOption("--stopped-short-refinements",
-                [&](std::string* e) { return relax::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
+                [&](std::string* e) { return dss::ValidStoppedShortRefinements(o.stopped_short_refinements, e); });
   RequireOption("--endpoint-refinements",
-                [&](std::string* e) { return relax::ValidEndpointRefinements(o.endpoint_refinements, e); });
-  RequireOption("--auto-split", [&](std::string* e) { return relax::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
+                [&](std::string* e) { return dss::ValidEndpointRefinements(o.endpoint_refinements, e); });
+  RequireOption("--auto-split", [&](std::string* e) { return dss::ValidAutoSplitRounds(o.auto_split, o.executor, e); });
 }
 
 // "csdp", or for --solver auto the backend of each order, e.g. "auto (csdp at order 2, dsdp at order 3)".
-std::string SolverText(const relax::BoundsOptions& options) {
+std::string SolverText(const dss::BoundsOptions& options) {
   if (options.solver != "auto") return options.solver;
   std::vector<std::string> parts;
   for (int d = std::min(options.order, 2); d <= options.order; ++d)  // the cheap pass runs at order 2 at most
     parts.push_back(fmt::format("{} at order {}",
-                                relax::SolverForOrder("auto", d, options.generation.block_order_cap), d));
+                                dss::SolverForOrder("auto", d, options.generation.block_order_cap), d));
   return fmt::format("auto ({})", fmt::join(parts, ", "));
 }
 
-relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
-  relax::BoundsOptions options;
-  options.order = o.order_given ? o.order : relax::MinimalOrder(o.horizon);
+dss::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
+  dss::BoundsOptions options;
+  options.order = o.order_given ? o.order : dss::MinimalOrder(o.horizon);
   options.solver = o.solver;
   options.threads = o.threads;
   options.executor = sdp::MakeExecutor(o.executor, o.threads);
@@ -207,7 +195,7 @@ relax::BoundsOptions MakeBoundsOptions(const BoundsCliOptions& o) {
 }
 
 // The result JSON; an invalidated model has "invalidated": true and null interval values.
-nlohmann::json ResultJson(const relax::BoundsSummary& summary, const BoundsCliOptions& o, const relax::HwOuterSet& set,
+nlohmann::json ResultJson(const dss::BoundsSummary& summary, const BoundsCliOptions& o, const dss::HwOuterSet& set,
                           const std::vector<double>& truth, bool covered) {
   auto j = summary.to_json();  // "invalidated", the verdict, null intervals and each orthant's certificate
   j["data"] = o.data;
@@ -324,17 +312,17 @@ void AddBoundsCommand(CLI::App& app) {
     if (!o->json_out.empty()) CheckOutputFile(o->json_out, "--json");
     const std::string plot_terminal = o->plot_out.empty() ? "" : CheckPlotOutput(o->plot_out);
     if (!o->run_dir.empty()) CheckOutputDirectory(o->run_dir, "--run-dir");
-    const relax::HwData data = ReadData(*o);
-    const relax::HwStructure structure = ReadStructure(*o);
-    const auto names = relax::MakeLayout(structure).names;
-    const relax::BoundsOptions options = MakeBoundsOptions(*o);
-    const relax::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
-    const std::vector<relax::BoxCut> cuts = parse_split(o->split);
-    RequireOption("--split", [&](std::string* e) { return relax::ValidBoxCuts(cuts, names, set.box(), e); });
+    const dss::HwData data = ReadData(*o);
+    const dss::HwStructure structure = ReadStructure(*o);
+    const auto names = dss::MakeLayout(structure).names;
+    const dss::BoundsOptions options = MakeBoundsOptions(*o);
+    const dss::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
+    const std::vector<dss::BoxCut> cuts = parse_split(o->split);
+    RequireOption("--split", [&](std::string* e) { return dss::ValidBoxCuts(cuts, names, set.box(), e); });
     for (const auto& w : set.warnings()) fmt::print(stderr, "WARNING: {}\n", w);
     if (!options.executor->is_coordinator()) {  // an MPI worker rank: serve jobs (same options), print nothing
-      const auto outer = relax::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
-      if (o->set == "exact") exact::ComputeExactBounds(MakeExactOptions(*o, options), structure, data, StartBoxFrom(outer, set));
+      const auto outer = dss::ComputeBoundsInPieces(options, set, cuts);  // --auto-split is refused under mpi
+      if (o->set == "exact") exact::ComputeExactBounds(MakeExactOptions(*o, options), structure, data, exact::StartBoxFromOuter(outer, set));
       return;
     }
     std::vector<double> truth;
@@ -349,19 +337,19 @@ void AddBoundsCommand(CLI::App& app) {
                SolverText(options), options.executor->name(), options.executor->workers());
     std::fflush(stdout);  // the header before the progress lines on stderr
     ProgressDisplay display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
-    relax::AutoSplitOptions auto_split;
+    dss::AutoSplitOptions auto_split;
     auto_split.rounds = o->auto_split;
-    const auto summary = relax::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split,
-                                                           [&display](const relax::BoundsProgress& p) { display.Show(p); });
+    const auto summary = dss::ComputeBoundsWithAutoSplit(options, set, cuts, auto_split,
+                                                           [&display](const dss::BoundsProgress& p) { display.Show(p); });
     display.Finish();
     const bool invalidated = summary.invalidated();
-    const bool covered = relax::TruthCovered(summary, truth);
-    relax::BoundsReportOptions report;
+    const bool covered = dss::TruthCovered(summary, truth);
+    dss::BoundsReportOptions report;
     report.truth = truth;
     report.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", o->na, o->nb,
                                      o->input_basis, o->output_basis, o->horizon);
     report.verify = !o->no_verify;
-    fmt::print("{}", relax::FullReport(summary, report));
+    fmt::print("{}", dss::FullReport(summary, report));
     nlohmann::json result = ResultJson(summary, *o, set, truth, covered);
     result["set"] = "dss";
     bool exact_invalidated = false;
@@ -369,32 +357,24 @@ void AddBoundsCommand(CLI::App& app) {
       std::fflush(stdout);
       ProgressDisplay exact_display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
       const auto exact_summary = exact::ComputeExactBounds(
-          MakeExactOptions(*o, options), structure, data, StartBoxFrom(summary, set),
+          MakeExactOptions(*o, options), structure, data, exact::StartBoxFromOuter(summary, set),
           [&exact_display](const exact::ExactBoundsProgress& p) {
-            relax::BoundsProgress line;
-            line.phase = fmt::format("exact set: {}{}{}", p.phase, p.detail.empty() ? "" : ": ", p.detail);
-            line.done = line.total = -1;
+            dss::BoundsProgress line;
+            line.phase = "exact set: " + p.phase;
+            line.done = p.done;
+            line.total = p.total;
             line.elapsed_seconds = p.elapsed_seconds;
             exact_display.Show(line);
           });
       exact_display.Finish();
       exact::ExactReportOptions exact_report;
       exact_report.truth = truth;
-      for (const auto& iv : StartBoxFrom(summary, set)) exact_report.outer.emplace_back(iv.lo, iv.hi);
+      for (const auto& iv : exact::StartBoxFromOuter(summary, set)) exact_report.outer.emplace_back(iv.lo, iv.hi);
       exact_report.outer_label = fmt::format("D^ss({})", o->horizon);
       exact_report.stage1_seconds = summary.wall_seconds;
       exact_report.model_class = report.model_class + ", noise bound per sample from the recording or --noise-bound";
       fmt::print("{}", exact::ExactReport(exact_summary, exact_report));
-      nlohmann::json j = exact_summary.to_json();
-      j["set"] = "exact";
-      j["outer_set_intervals"] = result["intervals"];
-      j["outer_set"] = {{"horizon", o->horizon}, {"order", options.order}, {"wall_seconds", summary.wall_seconds}};
-      for (const char* key : {"data", "data_warnings", "structure"}) j[key] = result[key];
-      if (!truth.empty()) {
-        j["truth"] = truth;
-        j["truth_covered"] = exact::TruthInside(exact_summary, truth);
-      }
-      result = j;
+      result = exact::ExactResultJson(exact_summary, result, summary, truth);
       exact_invalidated = exact_summary.invalidated;
     }
     OutputFiles outputs;  // all or none, each renamed into place whole

@@ -5,9 +5,9 @@
 #include "cli/commands.hpp"
 #include "core/csv_table.hpp"
 #include "core/output_files.hpp"
-#include "relax/pop_json.hpp"
+#include "pop/pop_json.hpp"
+#include "pop/relaxation_size.hpp"
 #include "sdp/sdp_solver.hpp"
-#include "relax/relaxation_size.hpp"
 #include "sdp/sdpa_format.hpp"
 
 namespace hw::cli {
@@ -29,34 +29,34 @@ void AddPopCommand(CLI::App& app) {
   cmd->add_flag("--json", o->json, "machine-readable output");
   cmd->callback([o, order] {
     if (!o->export_path.empty()) CheckOutputFile(o->export_path, "--export");
-    const auto problem = relax::LoadPolyProblem(o->problem);
+    const auto problem = pop::LoadPolyProblem(o->problem);
     const bool order_given = order->count() > 0;
     if (order_given)
-      RequireOption("--order", [&](std::string* e) { return relax::ValidRelaxationOrder(problem, o->order, e); });
+      RequireOption("--order", [&](std::string* e) { return pop::ValidRelaxationOrder(problem, o->order, e); });
     RequireOption("--solver", [&](std::string* e) { return sdp::ValidSolverName(o->solver, e); });
-    relax::RelaxationOptions options;
+    pop::RelaxationOptions options;
     options.order = order_given ? o->order : 0;  // 0: the minimal order
     const int solve_order = order_given ? o->order : problem.minimal_order();
     // Refused, with the numbers, when larger than the memory available now; a large one that fits is announced.
-    RequireOption("--order", [&](std::string* e) { return relax::RelaxationFits(problem, solve_order, o->solver, e); });
-    const auto size = relax::EstimateRelaxationSize(problem, solve_order, o->solver);
+    RequireOption("--order", [&](std::string* e) { return pop::RelaxationFits(problem, solve_order, o->solver, e); });
+    const auto size = pop::EstimateRelaxationSize(problem, solve_order, o->solver);
     if (size.bytes > 1e8) fmt::print(stderr, "order {} relaxation: {}\n", solve_order, size.describe());
     auto solver = sdp::MakeSolver(o->solver);
-    const auto r = relax::SolveRelaxation(options, problem, *solver);
-    const bool failed = r.status == relax::RelaxationStatus::kSolverFailed || r.status == relax::RelaxationStatus::kInvalid;
+    const auto r = pop::SolveRelaxation(options, problem, *solver);
+    const bool failed = r.status == pop::RelaxationStatus::kSolverFailed || r.status == pop::RelaxationStatus::kInvalid;
     if (!o->export_path.empty() && !failed) {  // a result file: written only when the command succeeds
-      const relax::MomentRelaxation relaxation(problem, r.order);
+      const pop::MomentRelaxation relaxation(problem, r.order);
       sdp::WriteSdpaSparse(o->export_path, relaxation.lmi());
     }
     const auto names = problem.names.empty() ? default_variable_names(problem.num_vars) : problem.names;
     if (o->json) {
-      nlohmann::json j = relax::RelaxationJson(problem, r, o->solver);
+      nlohmann::json j = pop::RelaxationJson(problem, r, o->solver);
       if (!o->export_path.empty() && !failed) j["exported"] = o->export_path;
       fmt::print("{}\n", j.dump(2));
     } else {
       fmt::print("order {} relaxation ({} moments, {} blocks), solver {}: {}\n", r.order, r.num_moments, r.num_blocks,
-                 o->solver, relax::ToString(r.status));
-      if (r.status == relax::RelaxationStatus::kSolved) {
+                 o->solver, pop::ToString(r.status));
+      if (r.status == pop::RelaxationStatus::kSolved) {
         fmt::print("{} bound: {:.10g}\n", problem.maximize ? "upper" : "lower", r.bound);
         fmt::print("{}\n", r.message);
         for (const auto& x : r.minimizers) {

@@ -7,8 +7,8 @@
 #include "cli/commands.hpp"
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
-#include "core/output_files.hpp"
 #include "core/hw_model.hpp"
+#include "core/output_files.hpp"
 #include "core/recording.hpp"
 
 namespace hw::cli {

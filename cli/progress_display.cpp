@@ -11,7 +11,7 @@ namespace {
 
 constexpr const char* kRewriteLine = "\r\033[K";  // back to the line's start, erase it
 
-bool PhaseEnds(const relax::BoundsProgress& p) { return p.done >= p.total; }
+bool PhaseEnds(const dss::BoundsProgress& p) { return p.done >= p.total; }
 
 }  // namespace
 
@@ -21,7 +21,7 @@ ProgressMode ChooseProgressMode(std::FILE* out, bool quiet, bool verbose) {
   return ::isatty(::fileno(out)) ? ProgressMode::kLive : ProgressMode::kPlain;
 }
 
-std::string ProgressLine(const relax::BoundsProgress& p) {
+std::string ProgressLine(const dss::BoundsProgress& p) {
   return fmt::format("[{}] {}/{} jobs{}, elapsed {:.0f} s, ETA {:.0f} s", p.phase, p.done, p.total,
                      p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
                      p.elapsed_seconds, p.eta_seconds);
@@ -33,7 +33,7 @@ ProgressDisplay::ProgressDisplay(ProgressMode mode, std::FILE* out, double first
 
 ProgressDisplay::~ProgressDisplay() { Finish(); }
 
-void ProgressDisplay::Show(const relax::BoundsProgress& p) {
+void ProgressDisplay::Show(const dss::BoundsProgress& p) {
   if (mode_ == ProgressMode::kSilent) return;
   if (p.total < 0) return ShowMessage(p.phase);
   const std::string line = ProgressLine(p);
@@ -43,7 +43,7 @@ void ProgressDisplay::Show(const relax::BoundsProgress& p) {
   std::fflush(out_);
 }
 
-bool ProgressDisplay::PlainLineDue(const relax::BoundsProgress& p) {
+bool ProgressDisplay::PlainLineDue(const dss::BoundsProgress& p) {
   if (p.phase != plain_phase_ || p.done <= 0) {  // a phase starts: its clock is at 0
     plain_phase_ = p.phase;
     next_plain_line_ = first_line_seconds_;
@@ -54,7 +54,7 @@ bool ProgressDisplay::PlainLineDue(const relax::BoundsProgress& p) {
   return true;
 }
 
-void ProgressDisplay::ShowLive(const relax::BoundsProgress& p, const std::string& line) {
+void ProgressDisplay::ShowLive(const dss::BoundsProgress& p, const std::string& line) {
   if (!live_phase_.empty() && live_phase_ != p.phase) fmt::print(out_, "\n");  // a phase left unfinished stays
   fmt::print(out_, "{}{}", kRewriteLine, line);
   live_phase_ = p.phase;

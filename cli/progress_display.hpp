@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
 
 namespace hw::cli {
 
@@ -29,14 +29,14 @@ class ProgressDisplay {
   ProgressDisplay(const ProgressDisplay&) = delete;
   ProgressDisplay& operator=(const ProgressDisplay&) = delete;
 
-  void Show(const relax::BoundsProgress& p);
+  void Show(const dss::BoundsProgress& p);
   // Ends a live line still open, so that what is printed next starts on a line of its own.
   void Finish();
 
  private:
   void ShowMessage(const std::string& text);
-  void ShowLive(const relax::BoundsProgress& p, const std::string& line);
-  bool PlainLineDue(const relax::BoundsProgress& p);
+  void ShowLive(const dss::BoundsProgress& p, const std::string& line);
+  bool PlainLineDue(const dss::BoundsProgress& p);
 
   ProgressMode mode_;
   std::FILE* out_;
@@ -47,6 +47,6 @@ class ProgressDisplay {
 };
 
 // "[phase] 3/20 jobs (+2 from the run directory), elapsed 12 s, ETA 68 s".
-std::string ProgressLine(const relax::BoundsProgress& p);
+std::string ProgressLine(const dss::BoundsProgress& p);
 
 }  // namespace hw::cli

@@ -9,10 +9,10 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "dss/set_membership.hpp"
 #include "estimators/brouri/workflow.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 #include "estimators/esmaeilani/valve_case.hpp"
-#include "relax/set_membership.hpp"
 #include "sdp/job_executor.hpp"
 
 namespace hw::compare {
@@ -96,7 +96,7 @@ void DiscreteQuantities(const Scenario& s, const Plant& truth, const Plant& est,
 }
 
 Plant PlantFromTheta(const SetMembershipClass& cls, const std::vector<double>& theta) {
-  const auto layout = relax::MakeLayout(cls.structure);
+  const auto layout = dss::MakeLayout(cls.structure);
   Plant p;
   std::vector<double> in = {1.0}, inv = {1.0};
   for (int k = 0; k < layout.num_gamma; ++k) in.push_back(theta[layout.gamma_begin + k]);
@@ -115,7 +115,7 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
                       const Record& val) {
   json out = {{"applicable", true}};
   const auto& sm = s.setmembership;
-  relax::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
+  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
   auto box = sm.box;
   if (box.empty()) box.assign(cls.names.size(), {-sm.box_half_width, sm.box_half_width});
   if (box.size() != cls.names.size())
@@ -126,8 +126,8 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
       throw InputError(fmt::format("setmembership.box: the true {} = {} lies outside the prior box [{}, {}]; the "
                                    "bounds assume the box contains the truth", cls.names[k], cls.theta[k],
                                    box[k].first, box[k].second));
-  relax::HwOuterSet set(cls.structure, data, sm.horizon, box);
-  relax::BoundsOptions o;
+  dss::HwOuterSet set(cls.structure, data, sm.horizon, box);
+  dss::BoundsOptions o;
   o.order = sm.order;
   o.solver = sm.solver;
   o.parameters = sm.parameters;
@@ -136,7 +136,7 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
   o.executor = std::make_shared<sdp::InProcessExecutor>();
   std::string err;
   if (!o.IsValid(&err)) throw InputError("setmembership options: " + err);
-  const auto summary = relax::ComputeBounds(o, set);
+  const auto summary = dss::ComputeBounds(o, set);
   out["noise_bound"] = bound;
   out["samples"] = rec.u.size();
   out["orthants"] = {{"total", summary.orthants_total}, {"empty", summary.orthants_empty},
@@ -181,7 +181,7 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
 // normalisation), as the pairs are piecewise linear and no polynomial represents them exactly.
 json MapEsmaeilaniToSetMembership(const esmaeilani::EsmaeilaniModel& m, const HwModel& hm,
                                   const SetMembershipClass& cls, double lo, double hi) {
-  const auto layout = relax::MakeLayout(cls.structure);
+  const auto layout = dss::MakeLayout(cls.structure);
   const int din = static_cast<int>(cls.structure.input_basis.size());
   const int dout = static_cast<int>(cls.structure.output_basis.size());
   const auto uu = Linspace(lo, hi, 201);

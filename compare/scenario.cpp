@@ -10,9 +10,9 @@
 
 #include "core/csv_table.hpp"
 #include "core/json_input.hpp"
+#include "dss/basis.hpp"
+#include "dss/set_membership.hpp"
 #include "estimators/esmaeilani/valve_case.hpp"
-#include "relax/basis.hpp"
-#include "relax/set_membership.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::compare {
@@ -91,8 +91,8 @@ bool Scenario::IsValid(std::string* error) const {
   const auto& sm = setmembership;
   if (sm.samples < 10 || !(sm.box_half_width > 0)) return fail("setmembership: samples >= 10, box > 0");
   std::string e;  // the bounds command's checks, with its messages
-  if (!relax::ValidHorizon(sm.horizon, &e) || !relax::ValidOrder(sm.order, sm.horizon, &e) ||
-      !relax::ValidBoundsSolver(sm.solver, &e) || !relax::ValidContractionPasses(sm.contract_passes, &e))
+  if (!dss::ValidHorizon(sm.horizon, &e) || !dss::ValidOrder(sm.order, sm.horizon, &e) ||
+      !dss::ValidBoundsSolver(sm.solver, &e) || !dss::ValidContractionPasses(sm.contract_passes, &e))
     return fail("setmembership: " + e);
   const auto& es = esmaeilani;
   if (es.segments < 1 || es.samples < 20 || es.hold_min < 1 || es.hold_max < es.hold_min || es.grid_f < 2 ||
@@ -296,8 +296,8 @@ SetMembershipClass SetMembershipTruth(const Plant& plant) {
   std::vector<double> lag(m.linear.delay + m.linear.b.size(), 0.0);
   for (std::size_t j = 0; j < m.linear.b.size(); ++j) lag[m.linear.delay + j] = m.linear.b[j];
   auto& st = c.structure;
-  for (std::size_t k = 1; k <= in.size(); ++k) st.input_basis.push_back(relax::power_basis(static_cast<int>(k)));
-  for (std::size_t k = 1; k <= inv.size(); ++k) st.output_basis.push_back(relax::power_basis(static_cast<int>(k)));
+  for (std::size_t k = 1; k <= in.size(); ++k) st.input_basis.push_back(dss::power_basis(static_cast<int>(k)));
+  for (std::size_t k = 1; k <= inv.size(); ++k) st.output_basis.push_back(dss::power_basis(static_cast<int>(k)));
   st.na = static_cast<int>(m.linear.a.size());
   st.strictly_proper = lag[0] == 0.0;
   st.nb = std::max<int>(1, static_cast<int>(lag.size()) - 1);
@@ -307,7 +307,7 @@ SetMembershipClass SetMembershipTruth(const Plant& plant) {
     c.reason = "structure: " + err;
     return c;
   }
-  const auto layout = relax::MakeLayout(st);
+  const auto layout = dss::MakeLayout(st);
   c.names = layout.names;
   c.theta.assign(layout.count(), 0.0);
   for (int k = 0; k < layout.num_gamma; ++k) c.theta[layout.gamma_begin + k] = in[k + 1] / in[0];

@@ -25,8 +25,8 @@
 #include <nlohmann/json.hpp>
 
 #include "compare/plant.hpp"
+#include "dss/hw_outer_set.hpp"
 #include "estimators/brouri/system.hpp"
-#include "relax/hw_outer_set.hpp"
 
 namespace hw::compare {
 
@@ -87,8 +87,8 @@ Scenario LoadScenario(const std::string& name_or_path);
 struct SetMembershipClass {
   bool ok = false;
   std::string reason;
-  relax::HwStructure structure;
-  std::vector<double> theta;  // layout of relax::MakeLayout(structure)
+  dss::HwStructure structure;
+  std::vector<double> theta;  // layout of dss::MakeLayout(structure)
   std::vector<std::string> names;
 };
 SetMembershipClass SetMembershipTruth(const Plant& plant);

@@ -172,7 +172,7 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     double g = box[objective.parameter].mid();
     LpBasis basis = warm;
     std::optional<double> best;
-    for (int step = 0; step < 4; ++step) {
+    for (int step = 0; step < 8; ++step) {
       lifted.SetRatioObjective(ratio_j, k, g);
       for (double& c : lifted.lp.obj) c *= sigma * sign;
       BoundSolve s = SolveBound(lifted, solver, basis, options.lp);

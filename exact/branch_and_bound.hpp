@@ -28,14 +28,14 @@ ParamBox HullOf(const std::vector<ParamBox>& boxes);
 struct PruneStop {
   int max_levels = 80;       // levels of halving
   int max_boxes = 48;        // live boxes: past this the search stops halving
-  double resolution = 4.0;   // stop once every live box is at most 1/resolution of the live hull in every a_i
+  double resolution = 2.0;   // stop once every live box is at most 1/resolution of the live hull in every a_i
   bool IsValid(std::string* error) const;
 };
 // Whether the pruning search has reached its stop (boxes small against their hull, or a limit).
 bool PruneSearchDone(const LiftedData& data, const std::vector<ParamBox>& live, int level, const PruneStop& stop);
 
 struct ObjectiveSearchOptions {
-  int lp_budget = 40;              // LPs of one endpoint's refinement
+  int lp_budget = 16;              // LPs of one endpoint's refinement
   double min_relative_width = 1e-9;  // a box narrower than this (relative to the start box) is not halved
   bool IsValid(std::string* error) const;
 };

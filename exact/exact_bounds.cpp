@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
+#include "dss/bound_jobs.hpp"
 #include "exact/exact_jobs.hpp"
-#include "relax/bound_jobs.hpp"
 
 namespace hw::exact {
 namespace {
@@ -20,9 +20,11 @@ double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 // null: the caller keeps what it concerned (a box stays live; an endpoint falls back to the box edge).
 class JobRunner {
  public:
-  JobRunner(sdp::JobExecutor& executor, const relax::RunCache& cache, const sdp::JobFunction& fn, ExactBoundsSummary& s)
+  JobRunner(sdp::JobExecutor& executor, const dss::RunCache& cache, const sdp::JobFunction& fn, ExactBoundsSummary& s)
       : executor_(executor), cache_(cache), fn_(fn), summary_(s) {}
-  std::vector<nlohmann::json> Run(const std::vector<nlohmann::json>& specs) {
+  // `on_done(done, total)` after each job run here (jobs read from the run directory count as done at once).
+  std::vector<nlohmann::json> Run(const std::vector<nlohmann::json>& specs,
+                                  const std::function<void(int, int)>& on_done = {}) {
     std::vector<nlohmann::json> answers(specs.size());
     std::vector<std::string> texts, keys;
     std::vector<std::size_t> todo;
@@ -38,7 +40,10 @@ class JobRunner {
       keys.push_back(key);
       todo.push_back(i);
     }
-    const auto results = executor_.Map(texts, fn_);
+    int done = static_cast<int>(specs.size() - todo.size());
+    const auto results = executor_.Map(texts, fn_, [&](std::size_t, const sdp::JobResult&) {
+      if (on_done) on_done(++done, static_cast<int>(specs.size()));
+    });
     for (std::size_t n = 0; n < todo.size(); ++n) {
       ++summary_.jobs;
       if (!results[n].ok) continue;  // stays null
@@ -50,7 +55,7 @@ class JobRunner {
 
  private:
   sdp::JobExecutor& executor_;
-  const relax::RunCache& cache_;
+  const dss::RunCache& cache_;
   const sdp::JobFunction& fn_;
   ExactBoundsSummary& summary_;
 };
@@ -110,9 +115,9 @@ std::vector<LiveBox> Prune(const LiftedData& data, const ParamBox& start, const 
       for (const auto& l : live) b.push_back(l.box);
       const ParamBox hull = HullOf(b);
       const int a1 = data.layout.a_begin;
-      progress({"prune", level, 0,
-                fmt::format("level {}, {} boxes live, {} in [{:.6g}, {:.6g}]", level, live.size(),
-                            data.layout.names[a1], hull[a1].lo, hull[a1].hi),
+      progress({"prune (levels)", level, stop.max_levels,
+                fmt::format("{} boxes live, {} in [{:.6g}, {:.6g}]", live.size(), data.layout.names[a1], hull[a1].lo,
+                            hull[a1].hi),
                 SecondsSince(t0)});
     }
     if (live.empty()) break;
@@ -122,7 +127,7 @@ std::vector<LiveBox> Prune(const LiftedData& data, const ParamBox& start, const 
   return live;
 }
 
-std::vector<int> WantedParameters(const ExactBoundsOptions& options, const relax::ParameterLayout& lay) {
+std::vector<int> WantedParameters(const ExactBoundsOptions& options, const dss::ParameterLayout& lay) {
   std::vector<int> wanted;
   for (int k = 0; k < lay.count(); ++k)
     if (options.parameters.empty() ||
@@ -134,7 +139,7 @@ std::vector<int> WantedParameters(const ExactBoundsOptions& options, const relax
 // Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter) refined.
 void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
                 const InnerHull* inner, double target_ratio, JobRunner& runner, ExactBoundsSummary& s,
-                std::vector<ExactInterval>& intervals) {
+                std::vector<ExactInterval>& intervals, const std::function<void(int, int)>& on_done) {
   const auto& lay = data.layout;
   std::vector<nlohmann::json> specs;
   std::vector<Objective> objectives;
@@ -151,7 +156,7 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
       objectives.push_back({k, maximise});
       specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap));
     }
-  const auto answers = runner.Run(specs);
+  const auto answers = runner.Run(specs, on_done);
   for (std::size_t o = 0; o < objectives.size(); ++o) {
     const Objective& obj = objectives[o];
     ExactEndpoint& end = obj.maximise ? intervals[obj.parameter].upper : intervals[obj.parameter].lower;
@@ -255,8 +260,8 @@ nlohmann::json ExactBoundsSummary::to_json() const {
             {"executor", executor}}}};
 }
 
-ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const relax::HwStructure& structure,
-                                      const relax::HwData& data, const ParamBox& start_box,
+ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
+                                      const dss::HwData& data, const ParamBox& start_box,
                                       const std::function<void(const ExactBoundsProgress&)>& progress) {
   const auto t0 = Clock::now();
   std::string error;
@@ -289,7 +294,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const r
   }
   nlohmann::json meta = {{"engine", "exact"}, {"start_box", BoxToJson(start_box)}};
   const std::string key = JobKey(meta.dump() + std::to_string(lifted.num_samples));
-  const relax::RunCache cache(options.run_dir, "exact-" + key, meta);
+  const dss::RunCache cache(options.run_dir, "exact-" + key, meta);
   JobRunner runner(*executor, cache, fn, s);
 
   // 1. prune
@@ -322,7 +327,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const r
   std::optional<InnerHull> inner;
   if (options.inner_hull) {
     t = Clock::now();
-    if (progress) progress({"inner hull", 0, 0, "local searches", SecondsSince(t0)});
+    if (progress) progress({"inner hull (local searches)", 0, 1, "", SecondsSince(t0)});
     auto solver = MakeLpSolver(options.lp_solver);
     std::vector<double> start_point = live.front().point;
     if (start_point.empty())
@@ -336,17 +341,16 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const r
   // 3. bound, in sweeps: each later sweep starts in the box the earlier ones proved.
   t = Clock::now();
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-    if (progress) progress({fmt::format("bound (sweep {})", sweep + 1), sweep, options.sweeps, "", SecondsSince(t0)});
+    const std::string phase = fmt::format("bound (sweep {} of {}, endpoints)", sweep + 1, options.sweeps);
     ParamBox sweep_start = start_box;
     for (int k = 0; k < lay.count(); ++k) sweep_start[k] = Interval(s.intervals[k].lower.value, s.intervals[k].upper.value);
-    std::vector<ParamBox> sweep_boxes;
-    for (const auto& b : boxes) {
-      ParamBox c = b;
-      for (int k = 0; k < lay.count(); ++k)
-        if (k < lay.a_begin || k >= lay.a_begin + structure.na) c[k] = sweep_start[k];
-      sweep_boxes.push_back(c);
-    }
-    BoundSweep(lifted, sweep_start, sweep_boxes, inner ? &*inner : nullptr, options.target_ratio, runner, s, s.intervals);
+    // Each endpoint's search starts from the live hull (one box): it halves only where its bound is worst, which
+    // costs fewer LPs than bounding every live box of the pruning search first.
+    const std::vector<ParamBox> sweep_boxes = {sweep_start};
+    BoundSweep(lifted, sweep_start, sweep_boxes, inner ? &*inner : nullptr, options.target_ratio, runner, s, s.intervals,
+               [&](int done, int total) {
+                 if (progress) progress({phase, done, total, "", SecondsSince(t0)});
+               });
   }
   s.bound_seconds = SecondsSince(t);
   s.assumption = CheckAssumption(lifted, s.intervals);

@@ -16,9 +16,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Basis values are libm or pow results: within a few ulps of the exact value (glibc documents <= 2 ulps for
 // these functions; 8 leaves room).
-Interval BasisValue(const relax::BasisFunction& f, double w) { return Interval::WithUlps(f.value(w), 8.0); }
+Interval BasisValue(const dss::BasisFunction& f, double w) { return Interval::WithUlps(f.value(w), 8.0); }
 
-std::vector<Interval> BasisValues(const std::vector<relax::BasisFunction>& basis, double w) {
+std::vector<Interval> BasisValues(const std::vector<dss::BasisFunction>& basis, double w) {
   std::vector<Interval> v;
   for (const auto& f : basis) v.push_back(BasisValue(f, w));
   return v;
@@ -63,13 +63,13 @@ void AddMcCormick(LpProblem* lp, int prod, int x, Interval X, int y, Interval Y)
 
 }  // namespace
 
-LiftedData MakeLiftedData(const relax::HwStructure& structure, const relax::HwData& data, int grid_points) {
+LiftedData MakeLiftedData(const dss::HwStructure& structure, const dss::HwData& data, int grid_points) {
   std::string error;
   if (!structure.IsValid(&error)) throw InputError(error);
   if (!data.IsValid(&error)) throw InputError(error);
   LiftedData d;
   d.structure = structure;
-  d.layout = relax::MakeLayout(structure);
+  d.layout = dss::MakeLayout(structure);
   d.num_samples = static_cast<int>(data.y.size());
   double lo = kInf, hi = -kInf;
   for (int t = 0; t < d.num_samples; ++t) {

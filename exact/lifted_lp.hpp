@@ -21,16 +21,16 @@
 #include <string>
 #include <vector>
 
+#include "dss/hw_outer_set.hpp"
 #include "exact/interval.hpp"
 #include "exact/lp_problem.hpp"
-#include "relax/hw_outer_set.hpp"
 
 namespace hw::exact {
 
 // The data of one run, evaluated once: band ends and basis values as intervals that contain the exact ones.
 struct LiftedData {
-  relax::HwStructure structure;
-  relax::ParameterLayout layout;
+  dss::HwStructure structure;
+  dss::ParameterLayout layout;
   int num_samples = 0;
   std::vector<double> band_lo, band_hi;             // L_t = y_t - dy_t rounded down, H_t = y_t + dy_t rounded up
   std::vector<std::vector<Interval>> phi_lo, phi_hi; // [t][j]: phi_j(L_t), phi_j(H_t)
@@ -40,7 +40,7 @@ struct LiftedData {
   int first_lag() const { return structure.strictly_proper ? 1 : 0; }
 };
 // Checks the structure and data (throws hw::InputError with the sample's place for a non-finite value).
-LiftedData MakeLiftedData(const relax::HwStructure& structure, const relax::HwData& data, int grid_points = 64);
+LiftedData MakeLiftedData(const dss::HwStructure& structure, const dss::HwData& data, int grid_points = 64);
 
 // A box of the parameters in the layout's order [gamma_2.., alpha_2.., a_1..a_na, b_j0..b_nb].
 using ParamBox = std::vector<Interval>;

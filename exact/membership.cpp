@@ -17,7 +17,9 @@ struct AffineOutput {
   std::vector<double> offset;
   std::vector<std::vector<double>> coef;
   bool finite() const {
-    auto ok = [](const std::vector<double>& v) { return std::all_of(v.begin(), v.end(), [](double e) { return std::isfinite(e); }); };
+    auto ok = [](const std::vector<double>& v) {
+      return std::all_of(v.begin(), v.end(), [](double e) { return std::isfinite(e); });
+    };
     return ok(offset) && std::all_of(coef.begin(), coef.end(), ok);
   }
 };

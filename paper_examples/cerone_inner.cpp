@@ -14,9 +14,9 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "dss/inner_points.hpp"
 #include "paper_examples/cerone/paper_table.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/inner_points.hpp"
 
 
 int main(int argc, char** argv) {
@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   const auto ex = hw::SimulateCeroneExample(seed, samples, snr);
   const auto truth = hw::CeroneExample::TrueParameters();
-  hw::relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "cerone2011"};
+  hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "cerone2011"};
   nlohmann::json report = {{"samples", samples}, {"seed", seed}, {"snr_db", ex.snr_db}, {"noise_bound", ex.noise_bound}};
   std::string md = fmt::format(
       "# Inner witnesses of D^ss(n), paper-001 example\n\nN = {}, seed {}, realised SNR_w {:.2f} dB, prior box "
@@ -44,14 +44,14 @@ int main(int argc, char** argv) {
       "|---|---|---|---|---|---|---|---|\n",
       samples, seed, ex.snr_db);
   for (int n : horizons) {
-    hw::relax::HwOuterSet set(hw::relax::CeroneExampleStructure(), data, n,
+    hw::dss::HwOuterSet set(hw::dss::CeroneExampleStructure(), data, n,
                               std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
     const int l = set.orthant_of(truth);
     fmt::print("n = {}: truth in orthant {}, min slack at truth {:.3g}\n", n, l, set.min_slack(truth));
     for (int k = 0; k < set.num_vars(); ++k) {
       const std::string& name = set.layout().names[k];
-      const auto lo = hw::relax::LocalExtreme(set, l, k, -1, truth);
-      const auto hi = hw::relax::LocalExtreme(set, l, k, +1, truth);
+      const auto lo = hw::dss::LocalExtreme(set, l, k, -1, truth);
+      const auto hi = hw::dss::LocalExtreme(set, l, k, +1, truth);
       const double vlo = lo.found ? lo.value : truth[k], vhi = hi.found ? hi.value : truth[k];
       const auto p = hw::cerone::PaperTableInterval(name, n).value_or(hw::cerone::PaperInterval{NAN, NAN});
       const double ratio = 0.5 * (vhi - vlo) / p.half_width();

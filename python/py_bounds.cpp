@@ -1,4 +1,4 @@
-// hwbounds.bounds: guaranteed parameter intervals (relax::ComputeBounds over relax::HwOuterSet), the same
+// hwbounds.bounds: guaranteed parameter intervals (dss::ComputeBounds over dss::HwOuterSet), the same
 // engine and options as `hwbounds bounds`, with a progress callback and Ctrl-C.
 #include <algorithm>
 #include <cmath>
@@ -8,9 +8,11 @@
 
 #include "python/py_convert.hpp"
 #include "python/py_module.hpp"
-#include "relax/bounds_report.hpp"
-#include "relax/box_split.hpp"
-#include "relax/set_membership.hpp"
+#include "exact/exact_report.hpp"
+#include "exact/two_stage.hpp"
+#include "dss/bounds_report.hpp"
+#include "dss/box_split.hpp"
+#include "dss/set_membership.hpp"
 #include "sdp/job_executor.hpp"
 #include "sdp/sdp_solver.hpp"
 
@@ -27,7 +29,7 @@ std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::ve
     const std::string what = name.empty() ? "box" : "box['" + name + "']";
     const auto v = ToVector(p, what);
     if (v.size() != 2) throw py::value_error(fmt::format("{}: expected (LO, HI), got {} values", what, v.size()));
-    Require([&](std::string* e) { return relax::ValidBoxEntry(name, v[0], v[1], names, e); });
+    Require([&](std::string* e) { return dss::ValidBoxEntry(name, v[0], v[1], names, e); });
     return std::pair<double, double>{v[0], v[1]};
   };
   if (h.is_none()) return box;
@@ -55,9 +57,9 @@ std::vector<std::pair<double, double>> BoxFromPython(py::handle h, const std::ve
 
 // The cuts of the prior box: None (no cut) or {name: value or [values]}, as the CLI's --split NAME=V1,V2; the
 // values are checked against the box by the library (the CLI gets the same message).
-std::vector<relax::BoxCut> SplitFromPython(py::handle h, const std::vector<std::string>& names,
+std::vector<dss::BoxCut> SplitFromPython(py::handle h, const std::vector<std::string>& names,
                                            const std::vector<std::pair<double, double>>& box) {
-  std::vector<relax::BoxCut> cuts;
+  std::vector<dss::BoxCut> cuts;
   if (h.is_none()) return cuts;
   if (!py::isinstance<py::dict>(h))
     throw py::type_error("split: expected None or {name: value or [values]}, e.g. {'gamma2': 0.0}");
@@ -68,20 +70,20 @@ std::vector<relax::BoxCut> SplitFromPython(py::handle h, const std::vector<std::
                               ? std::vector<double>{v.cast<double>()}
                               : ToVector(v, what)});
   }
-  Require([&](std::string* e) { return relax::ValidBoxCuts(cuts, names, box, e); });
+  Require([&](std::string* e) { return dss::ValidBoxCuts(cuts, names, box, e); });
   return cuts;
 }
 
 std::vector<double> NoiseBound(py::handle h, std::size_t n) {
   if (py::isinstance<py::float_>(h) || py::isinstance<py::int_>(h)) {
     const double b = h.cast<double>();
-    Require([&](std::string* e) { return relax::ValidNoiseBound(b, e); });
+    Require([&](std::string* e) { return dss::ValidNoiseBound(b, e); });
     return std::vector<double>(n, b);
   }
   return ToVector(h, "noise_bound");
 }
 
-py::dict ProgressDict(const relax::BoundsProgress& p) {
+py::dict ProgressDict(const dss::BoundsProgress& p) {
   py::dict d;
   d["phase"] = p.phase;
   d["done"] = p.done;
@@ -93,55 +95,57 @@ py::dict ProgressDict(const relax::BoundsProgress& p) {
 }
 
 struct BoundsArgs {
-  relax::HwStructure structure;
+  dss::HwStructure structure;
   std::string input_basis, output_basis, executor;
   int horizon = 2;
   bool order_given = false;  // false: the minimal order of the horizon
-  relax::BoundsOptions options;
-  relax::AutoSplitOptions auto_split;
+  dss::BoundsOptions options;
+  dss::AutoSplitOptions auto_split;
+  std::string set = "dss";  // "dss" or "exact" (the exact set D inside the D^ss(n) box)
+  exact::ExactBoundsOptions exact;
 };
 
 py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs a, py::handle box, py::handle split,
                   py::object progress, const std::string& source, bool with_report) {
-  relax::HwData data;
+  dss::HwData data;
   data.source = source;
   data.u = ToVector(u, "u");
   data.y = ToVector(y, "y");
   data.noise_bound = NoiseBound(noise_bound, data.y.size());
-  a.structure.input_basis = relax::parse_basis(a.input_basis);
-  a.structure.output_basis = relax::parse_basis(a.output_basis);
+  a.structure.input_basis = dss::parse_basis(a.input_basis);
+  a.structure.output_basis = dss::parse_basis(a.output_basis);
   RequireValid(a.structure);
   RequireValid(data);
   // The CLI's checks of the same options (cli/cmd_bounds.cpp, CheckBoundsOptions).
-  Require([&](std::string* e) { return relax::ValidHorizon(a.horizon, e); });
-  if (a.order_given) Require([&](std::string* e) { return relax::ValidOrder(a.options.order, a.horizon, e); });
-  a.options.order = a.order_given ? a.options.order : relax::MinimalOrder(a.horizon);
-  Require([&](std::string* e) { return relax::ValidBoundsSolver(a.options.solver, e); });
-  Require([&](std::string* e) { return relax::ValidThreads(a.options.threads, e); });
+  Require([&](std::string* e) { return dss::ValidHorizon(a.horizon, e); });
+  if (a.order_given) Require([&](std::string* e) { return dss::ValidOrder(a.options.order, a.horizon, e); });
+  a.options.order = a.order_given ? a.options.order : dss::MinimalOrder(a.horizon);
+  Require([&](std::string* e) { return dss::ValidBoundsSolver(a.options.solver, e); });
+  Require([&](std::string* e) { return dss::ValidThreads(a.options.threads, e); });
   Require([&](std::string* e) { return sdp::ValidExecutorName(a.executor, e); });
-  Require([&](std::string* e) { return relax::ValidContractionPasses(a.options.contraction_passes, e); });
-  Require([&](std::string* e) { return relax::ValidBlockOrderCap(a.options.generation.block_order_cap, e); });
-  Require([&](std::string* e) { return relax::ValidStoppedShortRefinements(a.options.stopped_short_refinements, e); });
-  Require([&](std::string* e) { return relax::ValidEndpointRefinements(a.options.endpoint_refinements, e); });
-  Require([&](std::string* e) { return relax::ValidAutoSplitRounds(a.auto_split.rounds, a.executor, e); });
+  Require([&](std::string* e) { return dss::ValidContractionPasses(a.options.contraction_passes, e); });
+  Require([&](std::string* e) { return pop::ValidBlockOrderCap(a.options.generation.block_order_cap, e); });
+  Require([&](std::string* e) { return dss::ValidStoppedShortRefinements(a.options.stopped_short_refinements, e); });
+  Require([&](std::string* e) { return dss::ValidEndpointRefinements(a.options.endpoint_refinements, e); });
+  Require([&](std::string* e) { return dss::ValidAutoSplitRounds(a.auto_split.rounds, a.executor, e); });
   if (a.executor == "mpi")
     throw py::value_error(
         "executor 'mpi' runs under mpirun from the CLI (`hwbounds bounds --executor mpi`); use "
         "'fork' or 'inprocess' from Python");
   a.options.executor = sdp::MakeExecutor(a.executor, a.options.threads);
   RequireValid(a.options);
-  const auto names = relax::MakeLayout(a.structure).names;
-  const relax::HwOuterSet set(a.structure, data, a.horizon, BoxFromPython(box, names));
-  const std::vector<relax::BoxCut> cuts = SplitFromPython(split, names, set.box());
+  const auto names = dss::MakeLayout(a.structure).names;
+  const dss::HwOuterSet set(a.structure, data, a.horizon, BoxFromPython(box, names));
+  const std::vector<dss::BoxCut> cuts = SplitFromPython(split, names, set.box());
   // Ctrl-C is checked while the engine waits for its jobs and at every progress report.
   a.options.executor->set_interrupt_check(CheckPythonSignals);
-  auto report = [&progress](const relax::BoundsProgress& p) {
+  auto report = [&progress](const dss::BoundsProgress& p) {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (!progress.is_none()) progress(ProgressDict(p));
   };
   const auto summary = WithoutGil([&] {
-    return relax::ComputeBoundsWithAutoSplit(a.options, set, cuts, a.auto_split, report);
+    return dss::ComputeBoundsWithAutoSplit(a.options, set, cuts, a.auto_split, report);
   });
   nlohmann::json j = summary.to_json();
   j["data"] = source;
@@ -151,13 +155,33 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
                     {"proper", !a.structure.strictly_proper},
                     {"input_basis", a.input_basis},
                     {"output_basis", a.output_basis}};
+  if (a.set == "exact" && !summary.invalidated()) {
+    a.exact.executor = a.options.executor;
+    a.exact.run_dir = a.options.run_dir;
+    a.exact.parameters = a.options.parameters;
+    const exact::ExactBoundsSummary exact_summary = WithoutGil([&] {
+      return exact::ComputeExactBounds(a.exact, a.structure, data, exact::StartBoxFromOuter(summary, set));
+    });
+    nlohmann::json e = exact::ExactResultJson(exact_summary, j, summary, {});
+    if (with_report) {
+      exact::ExactReportOptions r;
+      for (const auto& iv : exact::StartBoxFromOuter(summary, set)) r.outer.emplace_back(iv.lo, iv.hi);
+      r.outer_label = fmt::format("D^ss({})", a.horizon);
+      r.stage1_seconds = summary.wall_seconds;
+      r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}", a.structure.na, a.structure.nb,
+                                  a.input_basis, a.output_basis);
+      e["full_report"] = exact::ExactReport(exact_summary, r);
+    }
+    return ToPython(e);
+  }
+  j["set"] = "dss";
   if (with_report) {  // the text the CLI prints after a run
-    relax::BoundsReportOptions r;
+    dss::BoundsReportOptions r;
     r.model_class = fmt::format("na = {}, nb = {}, input basis {}, output basis {}, horizon {}", a.structure.na,
                                 a.structure.nb, a.input_basis, a.output_basis, a.horizon);
     r.verify = a.options.generation.verify.enabled;
-    j["brief_report"] = relax::BriefReport(summary, r);
-    j["full_report"] = relax::FullReport(summary, r);
+    j["brief_report"] = dss::BriefReport(summary, r);
+    j["full_report"] = dss::FullReport(summary, r);
   }
   return ToPython(j);
 }
@@ -165,9 +189,9 @@ py::object Bounds(py::handle u, py::handle y, py::handle noise_bound, BoundsArgs
 }  // namespace
 
 void DefineBounds(py::module_& m) {
-  const relax::HwStructure s;
-  const relax::BoundsOptions o;
-  const relax::ConstraintGenerationOptions& g = o.generation;
+  const dss::HwStructure s;
+  const dss::BoundsOptions o;
+  const pop::ConstraintGenerationOptions& g = o.generation;
   m.def(
       "bounds",
       [](py::handle u, py::handle y, py::handle noise_bound, int na, int nb, std::string input_basis,
@@ -177,8 +201,14 @@ void DefineBounds(py::module_& m) {
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
          int row_block_order, int stopped_short_refinements, int endpoint_refinements, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
-         py::object progress, std::string source, bool report) {
+         py::object progress, std::string source, bool report, std::string set, int lp_budget, int sweeps) {
         BoundsArgs a;
+        if (set != "dss" && set != "exact")
+          throw py::value_error(fmt::format("set '{}' unknown; expected 'dss' or 'exact'", set));
+        a.set = set;
+        a.exact.search.lp_budget = lp_budget;
+        a.exact.sweeps = sweeps;
+        if (std::string error; !a.exact.IsValid(&error)) throw py::value_error(error);
         a.structure.na = na;
         a.structure.nb = nb;
         a.structure.strictly_proper = strictly_proper;
@@ -215,7 +245,7 @@ void DefineBounds(py::module_& m) {
       },
       R"doc(Guaranteed parameter intervals of a Hammerstein-Wiener model from a recording (paper 001), as
 `hwbounds bounds`. u, y: 1-D arrays; noise_bound: |eta_t| <= noise_bound (a number, or one per sample).
-Options mirror relax::HwStructure and relax::BoundsOptions (same names, defaults and validation messages);
+Options mirror dss::HwStructure and dss::BoundsOptions (same names, defaults and validation messages);
 row_block_order is the CLI's --row-block-order (generation.block_order_cap: -1 = full order, 1 at order 3 = the
 mixed relaxation with 9x9 data-row blocks).
 box: None (every parameter in [-10, 10]), (lo, hi), {name: (lo, hi)} or one pair per parameter.
@@ -229,6 +259,9 @@ progress: called as progress(dict(phase, done, total, from_cache, elapsed_second
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
 its worker processes; with run_dir a rerun resumes from the finished jobs.
+set: "dss" (the default: D^ss(n)) or "exact": the exact set D bounded inside the D^ss(n) box (CLI --set exact;
+docs/exact_set.md); lp_budget and sweeps are the CLI's --lp-budget and --sweeps. With "exact" the dict has
+"set": "exact", intervals of D (with the inner hull), "outer_set_intervals", "stage2" counts and "assumption".
 report: also return the text `hwbounds bounds` prints, as "brief_report" (the interval table and warnings, or the
 verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the bounds came from).)doc",
       py::arg("u"), py::arg("y"), py::arg("noise_bound"), py::arg("na") = s.na, py::arg("nb") = s.nb,
@@ -249,7 +282,8 @@ verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the 
       py::arg("endpoint_refinements") = o.endpoint_refinements, py::arg("max_rounds") = g.max_rounds,
       py::arg("add_per_round") = g.add_per_round, py::arg("violation_tolerance") = g.violation_tolerance,
       py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data",
-      py::arg("report") = false);
+      py::arg("report") = false, py::arg("set") = "dss",
+      py::arg("lp_budget") = exact::ObjectiveSearchOptions{}.lp_budget, py::arg("sweeps") = exact::ExactBoundsOptions{}.sweeps);
 }
 
 }  // namespace hw::python

@@ -42,7 +42,7 @@ void RequireValid(const Options& options, const std::string& prefix = "") {
 }
 
 // Raises ValueError with the message of a failed check the library shares with the CLI (`check(&message)` is
-// false for a bad value), e.g. Require([&](std::string* e) { return relax::ValidHorizon(horizon, e); }).
+// false for a bad value), e.g. Require([&](std::string* e) { return dss::ValidHorizon(horizon, e); }).
 template <typename Check>
 void Require(Check&& check) {
   std::string error;

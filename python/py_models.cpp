@@ -3,10 +3,10 @@
 
 #include "core/hw_model.hpp"
 #include "core/recording.hpp"
+#include "pop/pop_json.hpp"
+#include "pop/relaxation_size.hpp"
 #include "python/py_convert.hpp"
 #include "python/py_module.hpp"
-#include "relax/pop_json.hpp"
-#include "relax/relaxation_size.hpp"
 #include "sdp/sdp_solver.hpp"
 
 namespace hw::python {
@@ -48,28 +48,28 @@ unstable is refused unless allow_unstable (the CLI's --allow-unstable), and an o
 precision is an error, both with the CLI's message. Returns a numpy array.)doc",
       py::arg("model"), py::arg("u"), py::kw_only(), py::arg("allow_unstable") = false);
 
-  const relax::RelaxationOptions r;
+  const pop::RelaxationOptions r;
   m.def(
       "pop",
       [](py::handle problem, py::object order, const std::string& solver, double rank_tolerance,
          double extraction_tolerance) {
-        const relax::PolyProblem p = py::isinstance<py::str>(problem)
-                                         ? relax::LoadPolyProblem(problem.cast<std::string>())
-                                         : relax::ParsePolyProblem(ToJson(problem), "problem");
+        const pop::PolyProblem p = py::isinstance<py::str>(problem)
+                                         ? pop::LoadPolyProblem(problem.cast<std::string>())
+                                         : pop::ParsePolyProblem(ToJson(problem), "problem");
         // The CLI's checks of --order and --solver (cli/cmd_pop.cpp), in its order.
         const bool order_given = !order.is_none();
-        if (order_given) Require([&](std::string* e) { return relax::ValidRelaxationOrder(p, order.cast<int>(), e); });
+        if (order_given) Require([&](std::string* e) { return pop::ValidRelaxationOrder(p, order.cast<int>(), e); });
         Require([&](std::string* e) { return sdp::ValidSolverName(solver, e); });
-        relax::RelaxationOptions options;
+        pop::RelaxationOptions options;
         options.order = order_given ? order.cast<int>() : 0;  // 0: the minimal order
         options.rank_tolerance = rank_tolerance;
         options.extraction_tolerance = extraction_tolerance;
         RequireValid(options);
         const int solve_order = order_given ? options.order : p.minimal_order();
-        Require([&](std::string* e) { return relax::RelaxationFits(p, solve_order, solver, e); });
+        Require([&](std::string* e) { return pop::RelaxationFits(p, solve_order, solver, e); });
         auto backend = sdp::MakeSolver(solver);
-        const auto result = WithoutGil([&] { return relax::SolveRelaxation(options, p, *backend); });
-        return ToPython(relax::RelaxationJson(p, result, solver));
+        const auto result = WithoutGil([&] { return pop::SolveRelaxation(options, p, *backend); });
+        return ToPython(pop::RelaxationJson(p, result, solver));
       },
       R"doc(One moment (Lasserre) relaxation of a polynomial optimisation problem, as `hwbounds pop --json`.
 problem: a dict {"variables": [...], "minimize" | "maximize": "...", "constraints": [...], "box": {...}} or the

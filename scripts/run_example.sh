@@ -8,4 +8,4 @@ mkdir -p out
 ./build/cli/hwbounds bounds --data paper_examples/data/cerone2011_N300.csv --noise-col noise_bound \
   --na 2 --nb 2 --input-basis poly:3 --output-basis poly:3 --horizon 2 --order 2 \
   --truth 0.4,-0.1,0.8,3.2,1.8,0.9,1.6,2.1 --json out/example_bounds.json --plot out/example_bounds.png \
-  --run-dir runs/example
+  --set exact --run-dir runs/example

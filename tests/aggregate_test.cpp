@@ -1,12 +1,12 @@
-// Stage 6 of the bound engine (relax/aggregate.hpp) on hand-made job outcomes: endpoints are the extreme
+// Stage 6 of the bound engine (dss/aggregate.hpp) on hand-made job outcomes: endpoints are the extreme
 // orthant bounds, never beyond the prior box (an assumption of every result, said once), and failed jobs
 // fall back without dropping their orthant.
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/aggregate.hpp"
+#include "dss/aggregate.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 JobOutcome Solved(double bound) {
@@ -113,4 +113,4 @@ TEST(Aggregate, ACheapBoundTighterThanAShortOrderDeltaBoundIsUsed) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

@@ -13,12 +13,12 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/basis.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/moment_lp.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/basis.hpp"
+#include "dss/set_membership.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_lp.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 // Solves its first `good` problems with CSDP, then reports numerical trouble (a backend giving up mid-run).
@@ -41,8 +41,8 @@ class FailsAfter : public sdp::SdpSolver {
 };
 
 // min x1 in [-1, 1]^2 with candidates x1 >= 0.5 (active) and x2 <= 0.9 (inactive).
-PolyProblem Core() {
-  PolyProblem p;
+pop::PolyProblem Core() {
+  pop::PolyProblem p;
   p.num_vars = 2;
   p.objective = Polynomial::Variable(2, 0);
   for (int i = 0; i < 2; ++i)
@@ -55,32 +55,32 @@ std::vector<Polynomial> Candidates() {
 }
 
 TEST(ConstraintGeneration, AFailedRoundFallsBackToTheLastSolvedRound) {
-  ConstraintGenerationOptions o;
+  pop::ConstraintGenerationOptions o;
   o.order = 1;
   o.add_per_round = 1;
   o.linear_rows_first = false;  // candidates enter only as blocks, so that a second round is needed
   // Reference: the full run needs a second round and reaches 0.5.
   auto csdp = sdp::MakeSolver("csdp");
-  const auto full = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, *csdp);
-  ASSERT_EQ(full.status, RelaxationStatus::kSolved) << full.message;
+  const auto full = pop::SolveWithConstraintGeneration(o, Core(), Candidates(), {}, *csdp);
+  ASSERT_EQ(full.status, pop::RelaxationStatus::kSolved) << full.message;
   ASSERT_GE(full.rounds, 2);
   EXPECT_NEAR(full.bound, 0.5, 1e-5);
   EXPECT_TRUE(full.tight);
   // Round 2 fails: the round-1 bound (the box, -1) is reported, valid, not tight, and verified.
   FailsAfter failing(1);
-  const auto r = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, failing);
-  ASSERT_EQ(r.status, RelaxationStatus::kSolved) << r.message;
+  const auto r = pop::SolveWithConstraintGeneration(o, Core(), Candidates(), {}, failing);
+  ASSERT_EQ(r.status, pop::RelaxationStatus::kSolved) << r.message;
   EXPECT_FALSE(r.tight);
   EXPECT_NEAR(r.bound, -1.0, 1e-5);
   EXPECT_LE(r.bound, full.bound + 1e-9);
   EXPECT_TRUE(r.verification.verified()) << r.verification.message;
-  EXPECT_EQ(r.origin, BoundOrigin::kEarlierRound);
+  EXPECT_EQ(r.origin, pop::BoundOrigin::kEarlierRound);
   EXPECT_EQ(r.bound_round, 1);
   EXPECT_NE(r.message.find("the bound of round 1 is reported"), std::string::npos) << r.message;
   // A failure in the first round has nothing to fall back to: the job fails.
   FailsAfter always(0);
-  const auto none = SolveWithConstraintGeneration(o, Core(), Candidates(), {}, always);
-  EXPECT_EQ(none.status, RelaxationStatus::kSolverFailed);
+  const auto none = pop::SolveWithConstraintGeneration(o, Core(), Candidates(), {}, always);
+  EXPECT_EQ(none.status, pop::RelaxationStatus::kSolverFailed);
 }
 
 // Solves with CSDP capped at a few iterations: the solve stops short, but its last iterate X comes back.
@@ -98,16 +98,16 @@ class StopsShort : public sdp::SdpSolver {
 };
 
 TEST(ConstraintGeneration, ASolveThatStopsShortStillGivesAVerifiedBound) {
-  ConstraintGenerationOptions o;
+  pop::ConstraintGenerationOptions o;
   o.order = 2;
   // min x1 over the disc x1^2 + x2^2 <= 0.5 in the box: -sqrt(0.5).
-  PolyProblem core = Core();
+  pop::PolyProblem core = Core();
   const auto x1 = Polynomial::Variable(2, 0), x2 = Polynomial::Variable(2, 1);
   std::vector<Polynomial> candidates = {Polynomial::Constant(2, 0.5) - x1 * x1 - x2 * x2};
   StopsShort short_solver;
-  const auto r = SolveWithConstraintGeneration(o, core, candidates, {}, short_solver);
+  const auto r = pop::SolveWithConstraintGeneration(o, core, candidates, {}, short_solver);
   ASSERT_NE(r.last_sdp.status, sdp::SdpStatus::kOptimal) << "the capped solve was expected to stop short";
-  ASSERT_EQ(r.status, RelaxationStatus::kSolved) << r.message;
+  ASSERT_EQ(r.status, pop::RelaxationStatus::kSolved) << r.message;
   EXPECT_TRUE(r.verification.verified()) << r.verification.message;
   EXPECT_TRUE(r.bound_from_unfinished_solve);
   EXPECT_FALSE(r.tight);
@@ -115,7 +115,7 @@ TEST(ConstraintGeneration, ASolveThatStopsShortStillGivesAVerifiedBound) {
   EXPECT_TRUE(std::isfinite(r.bound));         // weak, perhaps: an unfinished iterate bounds loosely
   // Without verification, a solve that stopped short gives no bound at all.
   o.verify.enabled = false;
-  EXPECT_EQ(SolveWithConstraintGeneration(o, core, candidates, {}, short_solver).status, RelaxationStatus::kSolverFailed);
+  EXPECT_EQ(pop::SolveWithConstraintGeneration(o, core, candidates, {}, short_solver).status, pop::RelaxationStatus::kSolverFailed);
 }
 
 // CSDP that counts its solves: the other backend of a job.
@@ -133,44 +133,44 @@ class CountingSolver : public sdp::SdpSolver {
 };
 
 TEST(ConstraintGeneration, AnUndecidedRoundGoesToTheOtherBackendOnlyWhenAsked) {
-  ConstraintGenerationOptions o;
+  pop::ConstraintGenerationOptions o;
   o.order = 2;
   const auto x1 = Polynomial::Variable(2, 0), x2 = Polynomial::Variable(2, 1);
   std::vector<Polynomial> candidates = {Polynomial::Constant(2, 0.5) - x1 * x1 - x2 * x2};
   StopsShort short_solver;
   // Default: the round that stopped short keeps its verified last iterate; the other backend is not asked.
   CountingSolver other;
-  const auto kept = SolveWithConstraintGeneration(o, Core(), candidates, {}, short_solver, {}, &other);
-  ASSERT_EQ(kept.status, RelaxationStatus::kSolved) << kept.message;
+  const auto kept = pop::SolveWithConstraintGeneration(o, Core(), candidates, {}, short_solver, {}, &other);
+  ASSERT_EQ(kept.status, pop::RelaxationStatus::kSolved) << kept.message;
   EXPECT_EQ(other.calls, 0);
   EXPECT_TRUE(kept.bound_from_unfinished_solve);
   EXPECT_LE(kept.bound, -std::sqrt(0.5) + 1e-9);
   // Asked for: the other backend solves the same LMI, and its converged round gives the bound.
   o.retry_undecided_rounds = true;
   CountingSolver retry;
-  const auto retried = SolveWithConstraintGeneration(o, Core(), candidates, {}, short_solver, {}, &retry);
-  ASSERT_EQ(retried.status, RelaxationStatus::kSolved) << retried.message;
+  const auto retried = pop::SolveWithConstraintGeneration(o, Core(), candidates, {}, short_solver, {}, &retry);
+  ASSERT_EQ(retried.status, pop::RelaxationStatus::kSolved) << retried.message;
   EXPECT_GE(retry.calls, 1);
   EXPECT_FALSE(retried.bound_from_unfinished_solve);
   EXPECT_NEAR(retried.bound, -std::sqrt(0.5), 1e-5);
   EXPECT_LE(retried.bound, -std::sqrt(0.5) + 1e-9);
 }
 
-TEST(LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
+TEST(pop::LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
   auto solver = sdp::MakeSolver("csdp");
   // x1 >= 0.5 and x1 + x2 <= 0.2 inside [-1, 1]^2: x1 in [0.5, 1], x2 <= -0.3.
   std::vector<Polynomial> cons = {Polynomial::Variable(2, 0) - Polynomial::Constant(2, 0.5),
                                   Polynomial::Constant(2, 0.2) - Polynomial::Variable(2, 0) - Polynomial::Variable(2, 1)};
-  const auto lo = LinearProgramBound(cons, 2, 0, -1, {}, *solver);
-  ASSERT_EQ(lo.status, LinearProgramBoundResult::kBounded) << lo.summary_message;
+  const auto lo = pop::LinearProgramBound(cons, 2, 0, -1, {}, *solver);
+  ASSERT_EQ(lo.status, pop::LinearProgramBoundResult::kBounded) << lo.summary_message;
   EXPECT_LE(lo.bound, 0.5);
   EXPECT_NEAR(lo.bound, 0.5, 1e-6);
-  const auto hi = LinearProgramBound(cons, 2, 1, +1, {}, *solver);
-  ASSERT_EQ(hi.status, LinearProgramBoundResult::kBounded) << hi.summary_message;
+  const auto hi = pop::LinearProgramBound(cons, 2, 1, +1, {}, *solver);
+  ASSERT_EQ(hi.status, pop::LinearProgramBoundResult::kBounded) << hi.summary_message;
   EXPECT_GE(hi.bound, -0.3);
   EXPECT_NEAR(hi.bound, -0.3, 1e-6);
   cons.push_back(Polynomial::Constant(2, -0.8) - Polynomial::Variable(2, 0));  // x1 <= -0.8: empty
-  EXPECT_EQ(LinearProgramBound(cons, 2, 0, -1, {}, *solver).status, LinearProgramBoundResult::kEmpty);
+  EXPECT_EQ(pop::LinearProgramBound(cons, 2, 0, -1, {}, *solver).status, pop::LinearProgramBoundResult::kEmpty);
 }
 
 // A small Hammerstein-Wiener system that keeps the test fast: x = u, z_t = -a1 z_{t-1} + b1 x_{t-1},
@@ -289,4 +289,4 @@ TEST(BoxContraction, TheFullPassRunsInTheBoxesOfTheCheapBounds) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

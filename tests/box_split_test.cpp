@@ -1,4 +1,4 @@
-// Bounds over a split prior box (relax/box_split.hpp): the pieces cover the box, the hull over the pieces keeps
+// Bounds over a split prior box (dss/box_split.hpp): the pieces cover the box, the hull over the pieces keeps
 // the guarantees (the weakest status and verification of the pieces it rests on), a piece proven empty drops out,
 // and a run over pieces contains the truth as the whole-box run does.
 #include <gtest/gtest.h>
@@ -8,10 +8,10 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
-#include "relax/box_split.hpp"
+#include "dss/box_split.hpp"
 #include "tests/seeded_example.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 const std::vector<std::string> kNames = {"p", "q", "r"};
@@ -280,4 +280,4 @@ TEST(ComputeBoundsInPieces, ARerunReadsEveryPieceBackFromTheRunDirectory) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

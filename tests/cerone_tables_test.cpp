@@ -7,12 +7,12 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
+#include "dss/edge_witness.hpp"
 #include "paper_examples/cerone/equivalent_snr.hpp"
 #include "paper_examples/cerone/table_properties.hpp"
 #include "paper_examples/cerone/tables_cli.hpp"
 #include "paper_examples/cerone/tables_report.hpp"
 #include "paper_examples/cerone/tables_run.hpp"
-#include "relax/edge_witness.hpp"
 
 namespace hw::cerone {
 namespace {
@@ -57,7 +57,7 @@ TEST(CeroneTables, SmallRunHoldsEveryPropertyAndWritesTheFields) {
     EXPECT_LE(outer->lower.value, inner.lower) << inner.name;
     EXPECT_GE(outer->upper.value, inner.upper) << inner.name;
     for (const auto* w : {&inner.lower_witness, &inner.upper_witness}) {  // re-certified here, independently
-      EXPECT_GE(relax::CertifiedMinSlack(set, w->orthant, w->point), 0.0) << inner.name;
+      EXPECT_GE(dss::CertifiedMinSlack(set, w->orthant, w->point), 0.0) << inner.name;
       EXPECT_EQ(set.orthant_of(w->point), w->orthant);
     }
   }
@@ -114,7 +114,7 @@ TEST(CeroneTables, OuterIntervalBoxIntersectsEveryRunWithTheStartingBox) {
   TableCase c;
   c.names = {"a1", "b1"};
   c.outer_box = {{-10, 10}, {-1, 1}};
-  relax::ParameterInterval a1, b1, a1_tighter;
+  dss::ParameterInterval a1, b1, a1_tighter;
   a1.name = a1_tighter.name = "a1", b1.name = "b1";
   a1.lower.value = -2, a1.upper.value = 3;
   a1_tighter.lower.value = -1, a1_tighter.upper.value = 5;
@@ -131,8 +131,8 @@ TEST(CeroneTables, OuterIntervalBoxIntersectsEveryRunWithTheStartingBox) {
 }
 
 // A synthetic interval for the checker.
-relax::ParameterInterval Iv(const std::string& name, double lo, double hi) {
-  relax::ParameterInterval iv;
+dss::ParameterInterval Iv(const std::string& name, double lo, double hi) {
+  dss::ParameterInterval iv;
   iv.name = name;
   iv.lower.value = lo;
   iv.upper.value = hi;
@@ -277,7 +277,7 @@ TEST(CeroneTables, GivenPointsWidenTheInnerHullOnlyWhenTheyCertify) {
   short_searches.random_starts = 0;
   short_searches.restart_rounds = 0;
   short_searches.local.max_iterations = 1;
-  const auto far = relax::LocalExtreme(set, set.orthant_of(truth), a1[0], -1, truth);
+  const auto far = dss::LocalExtreme(set, set.orthant_of(truth), a1[0], -1, truth);
   ASSERT_TRUE(far.found);
   const InnerHull own = ComputeInnerHull(set, truth, a1, short_searches);
   ASSERT_TRUE(own.intervals[0].found);
@@ -288,7 +288,7 @@ TEST(CeroneTables, GivenPointsWidenTheInnerHullOnlyWhenTheyCertify) {
   EXPECT_EQ(seeded.given_witnesses, 1);
   EXPECT_EQ(seeded.intervals[0].lower, far.value);
   EXPECT_EQ(seeded.intervals[0].upper, own.intervals[0].upper);
-  EXPECT_GE(relax::CertifiedMinSlack(set, seeded.intervals[0].lower_witness.orthant, seeded.intervals[0].lower_witness.point), 0.0);
+  EXPECT_GE(dss::CertifiedMinSlack(set, seeded.intervals[0].lower_witness.orthant, seeded.intervals[0].lower_witness.point), 0.0);
 }
 
 int Parse(const std::vector<std::string>& args, TablesCommand* command = nullptr) {

@@ -8,7 +8,7 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
-#include "relax/hw_outer_set.hpp"
+#include "dss/hw_outer_set.hpp"
 #include "tests/test_support.hpp"
 
 namespace hw {
@@ -18,9 +18,9 @@ using testing_support::ErrorOf;
 using testing_support::Has;
 
 // A small recording of the paper's example with data rows on file lines 2.. (a header on line 1).
-relax::HwData Recording(int samples) {
+dss::HwData Recording(int samples) {
   const auto ex = SimulateCeroneExample(3, samples);
-  relax::HwData d;
+  dss::HwData d;
   d.u = ex.u;
   d.y = ex.y;
   d.noise_bound.assign(ex.y.size(), ex.noise_bound);
@@ -29,8 +29,8 @@ relax::HwData Recording(int samples) {
   return d;
 }
 
-relax::HwOuterSet Set(const relax::HwData& d) {
-  return relax::HwOuterSet(relax::CeroneExampleStructure(), d, 1,
+dss::HwOuterSet Set(const dss::HwData& d) {
+  return dss::HwOuterSet(dss::CeroneExampleStructure(), d, 1,
                            std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
 }
 

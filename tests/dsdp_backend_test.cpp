@@ -11,10 +11,10 @@
 #include <string>
 
 #include "core/cerone_example.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/moment_relaxation.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "dss/set_membership.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_relaxation.hpp"
 #include "sdp/sdp_solver.hpp"
 #include "sdp/sdpa_format.hpp"
 #include "sdp/verified_bound.hpp"
@@ -177,9 +177,9 @@ TEST(DsdpBackend, DiagonalBlocksOnly) {
 }
 
 // min x1 + x2 over { x1^2 + x2^2 <= 1/2 } in [-1, 1]^2: optimum -1 at (-1/2, -1/2), attained by the relaxation.
-relax::PolyProblem DiscInBox() {
+pop::PolyProblem DiscInBox() {
   const std::vector<std::string> v = {"x1", "x2"};
-  relax::PolyProblem p;
+  pop::PolyProblem p;
   p.num_vars = 2;
   p.names = v;
   p.objective = parse_polynomial("x1 + x2", v);
@@ -190,10 +190,10 @@ relax::PolyProblem DiscInBox() {
 
 TEST(DsdpBackend, MultiplierGivesAVerifiedBoundAtTheOptimum) {
   const auto p = DiscInBox();
-  relax::MomentRelaxation r(p, 2);
+  pop::MomentRelaxation r(p, 2);
   const auto s = SolveWith("dsdp", r.lmi());
   ASSERT_TRUE(s.usable()) << s.message;
-  const auto v = VerifyLowerBound(r.lmi(), s.X, relax::MomentVariableBounds(p, r), s.lower_bound);
+  const auto v = VerifyLowerBound(r.lmi(), s.X, pop::MomentVariableBounds(p, r), s.lower_bound);
   ASSERT_TRUE(v.verified()) << v.message;
   EXPECT_LE(v.bound, -1.0);         // rigorous: never above the optimum
   EXPECT_GE(v.bound, -1.0 - 1e-6);  // and tight
@@ -201,13 +201,13 @@ TEST(DsdpBackend, MultiplierGivesAVerifiedBoundAtTheOptimum) {
 
 TEST(DsdpBackend, SolveStoppedShortStillReturnsAVerifiableMultiplier) {
   const auto p = DiscInBox();
-  relax::MomentRelaxation r(p, 2);
+  pop::MomentRelaxation r(p, 2);
   SdpOptions o;
   o.max_iterations = 6;
   const auto s = SolveWith("dsdp", r.lmi(), o);
   ASSERT_EQ(s.status, SdpStatus::kIterationLimit) << s.message;
   ASSERT_EQ(s.X.size(), r.lmi().blocks.size());
-  const auto v = VerifyLowerBound(r.lmi(), s.X, relax::MomentVariableBounds(p, r), s.lower_bound);
+  const auto v = VerifyLowerBound(r.lmi(), s.X, pop::MomentVariableBounds(p, r), s.lower_bound);
   ASSERT_TRUE(v.verified()) << v.message;
   EXPECT_TRUE(std::isfinite(v.bound));
   EXPECT_LE(v.bound, -1.0);
@@ -272,12 +272,12 @@ TEST(DsdpBackend, VerbosePrintsTheIterationLog) {
 TEST(DsdpBackend, QuietOnEveryOutcome) {
   // min x1^4 + x2^2 on the line x1 + x2 = 1, order 3: no interior, DSDP breaks down (indefinite Schur matrix).
   const std::vector<std::string> v = {"x1", "x2"};
-  relax::PolyProblem line;
+  pop::PolyProblem line;
   line.num_vars = 2;
   line.names = v;
   line.objective = parse_polynomial("x1^4 + x2^2", v);
   line.equalities = {parse_polynomial("x1 + x2 - 1", v)};
-  relax::MomentRelaxation no_interior(line, 3);
+  pop::MomentRelaxation no_interior(line, 3);
   SdpOptions capped;
   capped.max_iterations = 2;
   testing::internal::CaptureStdout();
@@ -297,18 +297,18 @@ TEST(DsdpBackend, QuietOnEveryOutcome) {
 // inequalities): the three backends agree on the bound.
 TEST(DsdpBackend, AgreesOnASetMembershipRelaxation) {
   const auto ex = SimulateCeroneExample(1, 200);
-  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "test"};
-  relax::HwOuterSet set(relax::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10, 10}));
+  dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "test"};
+  dss::HwOuterSet set(dss::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10, 10}));
   const int l = set.orthant_of(CeroneExample::TrueParameters());
   const auto cons = set.data_constraints(l);
-  relax::PolyProblem p;
+  pop::PolyProblem p;
   p.num_vars = 8;
   p.objective = Polynomial::Variable(8, set.layout().a_begin);
   p.inequalities = set.box_constraints();
   for (auto& g : set.sign_constraints(l)) p.inequalities.push_back(g);
   const int K = std::min<int>(40, cons.size());
   for (int k = 0; k < K; ++k) p.inequalities.push_back(cons[static_cast<std::size_t>(k) * cons.size() / K].g);
-  relax::MomentRelaxation r(p, 1);
+  pop::MomentRelaxation r(p, 1);
   const auto d = SolveWith("dsdp", r.lmi());
   ASSERT_TRUE(d.usable()) << d.message;
   for (const std::string other : {"csdp", "sdpa"}) {
@@ -316,7 +316,7 @@ TEST(DsdpBackend, AgreesOnASetMembershipRelaxation) {
     ASSERT_TRUE(o.usable()) << o.message;
     EXPECT_NEAR(d.lower_bound, o.lower_bound, 1e-6) << other;
   }
-  const auto v = VerifyLowerBound(r.lmi(), d.X, relax::MomentVariableBounds(p, r), d.lower_bound);
+  const auto v = VerifyLowerBound(r.lmi(), d.X, pop::MomentVariableBounds(p, r), d.lower_bound);
   ASSERT_TRUE(v.verified()) << v.message;
   EXPECT_GE(v.bound, d.lower_bound - 1e-6);
 }
@@ -325,20 +325,20 @@ TEST(DsdpBackend, AgreesOnASetMembershipRelaxation) {
 // example (N = 30, n = 1, order 1), the truth inside.
 TEST(DsdpBackend, SetMembershipEngineRunsWithDsdp) {
   std::string error;
-  relax::BoundsOptions options;
+  dss::BoundsOptions options;
   options.solver = "mosek";
   EXPECT_FALSE(options.IsValid(&error));
   options.solver = "dsdp";
   ASSERT_TRUE(options.IsValid(&error)) << error;
   const auto ex = SimulateCeroneExample(9, 30, 31.0);
-  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  relax::HwOuterSet set(relax::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10, 10}));
+  dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  dss::HwOuterSet set(dss::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10, 10}));
   options.order = 1;
   options.threads = 2;
   options.generation.retry_undecided_rounds = false;
-  const auto d = relax::ComputeBounds(options, set);
+  const auto d = dss::ComputeBounds(options, set);
   options.solver = "csdp";
-  const auto c = relax::ComputeBounds(options, set);
+  const auto c = dss::ComputeBounds(options, set);
   ASSERT_EQ(d.intervals.size(), c.intervals.size());
   const auto truth = CeroneExample::TrueParameters();
   for (std::size_t k = 0; k < d.intervals.size(); ++k) {

@@ -1,4 +1,4 @@
-// Endpoints settled by feasible points at the prior box edge (relax/edge_witness.hpp): the certified slack
+// Endpoints settled by feasible points at the prior box edge (dss/edge_witness.hpp): the certified slack
 // accepts points of D^ss(n) and rejects points outside, and a run with the stage gives the endpoints of a run
 // without it (every endpoint by SDP).
 #include <algorithm>
@@ -7,11 +7,11 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/edge_witness.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/edge_witness.hpp"
+#include "dss/set_membership.hpp"
 #include "seeded_example.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 TEST(EdgeWitness, CertifiedSlackAcceptsTheTruthAndRejectsAPointOutside) {
@@ -86,4 +86,4 @@ TEST(EdgeWitness, OptionsAreChecked) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

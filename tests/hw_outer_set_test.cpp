@@ -4,9 +4,9 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
-#include "relax/hw_outer_set.hpp"
+#include "dss/hw_outer_set.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 HwData FromExample(const CeroneExample& ex) {
@@ -62,4 +62,4 @@ TEST(HwOuterSet, BadInputIsRejectedClearly) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

@@ -4,12 +4,12 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/inner_points.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/inner_points.hpp"
+#include "dss/set_membership.hpp"
 
 extern "C" int openblas_get_num_threads();
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 TEST(InnerPoints, WitnessesAreFeasibleAndInsideTheGuaranteedIntervals) {
@@ -83,4 +83,4 @@ TEST(InnerPoints, AnInfeasibleRegionGivesNoWitness) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

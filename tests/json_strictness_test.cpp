@@ -11,7 +11,7 @@
 #include "core/hw_model.hpp"
 #include "estimators/brouri/experiment.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
-#include "relax/pop_json.hpp"
+#include "pop/pop_json.hpp"
 #include "tests/test_support.hpp"
 
 namespace hw {
@@ -24,16 +24,16 @@ using testing_support::Has;
 
 TEST(PopJsonKeys, UnknownKeyIsAnErrorNamingKeyFileAndAllowedKeys) {
   const auto j = json::parse(R"({"variables":["x1"],"minimize":"x1","constraint":["x1 >= 4"]})");
-  const std::string e = ErrorOf([&] { relax::ParsePolyProblem(j, "p.json"); });
+  const std::string e = ErrorOf([&] { pop::ParsePolyProblem(j, "p.json"); });
   EXPECT_TRUE(Has(e, "p.json")) << e;
   EXPECT_TRUE(Has(e, "unknown key 'constraint'")) << e;
   EXPECT_TRUE(Has(e, "constraints")) << e;  // the allowed keys are listed
-  EXPECT_THROW(relax::ParsePolyProblem(json::parse(R"({"variables":["x1"],"minimize":"x1","box":{"x1":[0,1],"y":[0,1]}})"),
+  EXPECT_THROW(pop::ParsePolyProblem(json::parse(R"({"variables":["x1"],"minimize":"x1","box":{"x1":[0,1],"y":[0,1]}})"),
                                        "p.json"),
                InputError);
-  EXPECT_THROW(relax::ParsePolyProblem(json::parse(R"({"variables":["x1","x1"],"minimize":"x1"})"), "p.json"),
+  EXPECT_THROW(pop::ParsePolyProblem(json::parse(R"({"variables":["x1","x1"],"minimize":"x1"})"), "p.json"),
                InputError);
-  EXPECT_THROW(relax::ParsePolyProblem(json::parse(R"({"variables":["x1"],"minimize":"x1","box":{"x1":["a",1]}})"),
+  EXPECT_THROW(pop::ParsePolyProblem(json::parse(R"({"variables":["x1"],"minimize":"x1","box":{"x1":["a",1]}})"),
                                        "p.json"),
                InputError);
 }

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "relax/constraint_generation.hpp"
-#include "relax/moment_relaxation.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_relaxation.hpp"
 
-namespace hw::relax {
+namespace hw::pop {
 namespace {
 
 Polynomial X(int i) { return Polynomial::Variable(3, i); }
@@ -79,4 +79,4 @@ TEST(MixedOrder, ACapBelowMinusOneIsRefused) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::pop

@@ -1,4 +1,4 @@
-// Feasible points from the relaxations' first moments (relax/moment_witness.hpp): the stage leaves every bound as
+// Feasible points from the relaxations' first moments (dss/moment_witness.hpp): the stage leaves every bound as
 // it is, its points certify in their orthants and lie inside the intervals, and they reach further towards the
 // endpoints than the points the other stages find.
 #include <cmath>
@@ -6,12 +6,12 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/bound_jobs.hpp"
-#include "relax/edge_witness.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/bound_jobs.hpp"
+#include "dss/edge_witness.hpp"
+#include "dss/set_membership.hpp"
 #include "seeded_example.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 TEST(MomentWitness, FirstMomentsSurviveTheRunCache) {
@@ -64,4 +64,4 @@ TEST(MomentWitness, PointsCertifyAndNarrowTheUnwitnessedPartWithoutMovingABound)
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

@@ -29,7 +29,7 @@
 #include "diagnose/recording.hpp"
 #include "estimators/brouri/experiment.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
-#include "relax/pop_json.hpp"
+#include "pop/pop_json.hpp"
 
 namespace hw {
 namespace {
@@ -319,7 +319,7 @@ std::vector<JsonReader> Readers() {
        json::parse(R"({"variables": ["x1", "x2"], "minimize": "x1^2 + x2",
                        "constraints": ["x1^2 + x2^2 <= 1", "x1 - x2 == 0", "x2 >= -1"],
                        "box": {"x1": [-2, 2], "x2": [-2, 2]}})"),
-       [](const json& j) { relax::ParsePolyProblem(j, "fuzz.json"); }},
+       [](const json& j) { pop::ParsePolyProblem(j, "fuzz.json"); }},
       {"model", CeroneModelJson(), [](const json& j) { HwModel::from_json(j); }},
       {"diagnose model", DiagnoseModelJson(), [](const json& j) { diagnose::AugmentedModel::from_json(j); }},
       {"compare scenario",

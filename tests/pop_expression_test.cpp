@@ -6,7 +6,7 @@
 
 #include "core/csv_table.hpp"
 #include "core/polynomial.hpp"
-#include "relax/pop_json.hpp"
+#include "pop/pop_json.hpp"
 #include "tests/test_support.hpp"
 
 namespace hw {
@@ -60,7 +60,7 @@ TEST(PolynomialParser, NumbersAreDecimalAndFinite) {
 
 TEST(PopJson, TheIssuesFractionalPowerProblemIsRejected) {
   const auto j = json::parse(R"({"variables":["x1"],"minimize":"x1^0.5","constraints":["x1 >= 4","x1 <= 9"]})");
-  const std::string e = ErrorOf([&] { relax::ParsePolyProblem(j, "p.json"); });
+  const std::string e = ErrorOf([&] { pop::ParsePolyProblem(j, "p.json"); });
   EXPECT_TRUE(Has(e, "p.json: minimize")) << e;
   EXPECT_TRUE(Has(e, "position 4")) << e;
 }

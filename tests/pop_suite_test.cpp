@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include "relax/moment_relaxation.hpp"
+#include "pop/moment_relaxation.hpp"
 
-namespace hw::relax {
+namespace hw::pop {
 namespace {
 
 struct Case {
@@ -234,4 +234,4 @@ TEST(PopSuite, InfeasibleProblemIsReportedInfeasible) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::pop

@@ -15,8 +15,8 @@
 
 #include <fmt/format.h>
 
-#include "relax/basis.hpp"
-#include "relax/hw_outer_set.hpp"
+#include "dss/basis.hpp"
+#include "dss/hw_outer_set.hpp"
 
 namespace hw::testing {
 
@@ -27,8 +27,8 @@ struct RandomHwOptions {
 };
 
 struct RandomHwInstance {
-  relax::HwStructure structure;
-  relax::HwData data;
+  dss::HwStructure structure;
+  dss::HwData data;
   std::vector<double> theta;  // the truth in the layout's order [gamma_2.., alpha_2.., a_1..a_na, b_j0..b_nb]
   std::vector<double> w;      // the noise-free output
   std::string description;    // structure and seed, for failure messages
@@ -91,14 +91,14 @@ inline std::vector<double> Input(int n, TestRng& rng) {
   return u;
 }
 
-inline double OutputMap(const relax::HwStructure& s, const std::vector<double>& alpha, double w) {
+inline double OutputMap(const dss::HwStructure& s, const std::vector<double>& alpha, double w) {
   double p = 0.0;
   for (std::size_t j = 0; j < alpha.size(); ++j) p += alpha[j] * s.output_basis[j].value(w);
   return p;
 }
 
 // The largest W <= 4 with p' >= 0.2 on [-W, W] (p(w) = w + ..., so p'(0) = 1), by a scan from 0 outward.
-inline double IncreasingHalfRange(const relax::HwStructure& s, const std::vector<double>& alpha) {
+inline double IncreasingHalfRange(const dss::HwStructure& s, const std::vector<double>& alpha) {
   const double h = 1e-3;
   for (double W = h; W <= 4.0; W += h) {
     for (double w : {W, -W})
@@ -108,7 +108,7 @@ inline double IncreasingHalfRange(const relax::HwStructure& s, const std::vector
 }
 
 // w with p(w) = z on [lo, hi], where p increases.
-inline double InvertOutputMap(const relax::HwStructure& s, const std::vector<double>& alpha, double z, double lo,
+inline double InvertOutputMap(const dss::HwStructure& s, const std::vector<double>& alpha, double z, double lo,
                               double hi) {
   for (int it = 0; it < 200 && hi - lo > 1e-15 * (1 + std::abs(lo)); ++it) {
     const double mid = 0.5 * (lo + hi);
@@ -130,8 +130,8 @@ inline RandomHwInstance MakeRandomHwInstance(uint64_t seed, const RandomHwOption
   const std::vector<std::string> input_bases = {"poly:1", "poly:2", "poly:3", "w,tanh"};
   const std::string input_name = input_bases[rng.integer(0, 3)];
   const std::string output_name = fmt::format("poly:{}", rng.integer(1, 3));
-  s.input_basis = relax::parse_basis(input_name);
-  s.output_basis = relax::parse_basis(output_name);
+  s.input_basis = dss::parse_basis(input_name);
+  s.output_basis = dss::parse_basis(output_name);
   const int j0 = s.strictly_proper ? 1 : 0;
   const int n = rng.integer(options.min_samples, options.max_samples);
   inst.description = fmt::format("seed {}: na {} nb {} {} input {} output {} N {}", seed, s.na, s.nb,

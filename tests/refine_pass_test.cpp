@@ -1,15 +1,15 @@
-// Endpoints resting on a solve that stopped short are solved again in a contracted box (relax/refine_pass.hpp):
+// Endpoints resting on a solve that stopped short are solved again in a contracted box (dss/refine_pass.hpp):
 // which endpoints qualify, and on a seeded instance whose solves are cut short by an iteration limit, the refined
 // intervals lie inside the unrefined ones and still contain the truth. The same for every open endpoint solved
 // again in the box of the full pass's own bounds (BoundsOptions::endpoint_refinements).
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/refine_pass.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/refine_pass.hpp"
+#include "dss/set_membership.hpp"
 #include "sdp/job_executor.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 JobOutcome Solved(double bound, bool unfinished) {
@@ -149,4 +149,4 @@ TEST(RefinePass, RefinedIntervalsLieInsideAndKeepTheTruth) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

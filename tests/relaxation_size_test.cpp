@@ -1,12 +1,12 @@
-// The memory model of relax/relaxation_size.hpp against measured peak resident memory.
+// The memory model of pop/relaxation_size.hpp against measured peak resident memory.
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "relax/relaxation_size.hpp"
+#include "pop/relaxation_size.hpp"
 
-namespace hw::relax {
+namespace hw::pop {
 namespace {
 
 // Peak resident memory of `hwbounds pop PROBLEM --order K --solver S` minus that of the same command at
@@ -52,4 +52,4 @@ TEST(RelaxationSize, CountsMomentsAndBlocks) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::pop

@@ -7,9 +7,9 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 namespace fs = std::filesystem;
@@ -133,4 +133,4 @@ TEST_F(Resume, RunsOfAnotherOrderReadBackTheJobsTheyShare) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

@@ -1,4 +1,4 @@
-// Exact row reduction (relax/row_reduction.hpp): dropped rows are implied, and on random small
+// Exact row reduction (dss/row_reduction.hpp): dropped rows are implied, and on random small
 // Hammerstein-Wiener instances the relaxation over the kept rows gives the same bound as over every row
 // (same solver, every row as its full localizing block).
 #include <algorithm>
@@ -10,14 +10,14 @@
 
 #include "compare/methods.hpp"
 #include "compare/scenario.hpp"
-#include "relax/basis.hpp"
-#include "relax/bound_jobs.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/row_reduction.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/basis.hpp"
+#include "dss/bound_jobs.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "dss/row_reduction.hpp"
+#include "dss/set_membership.hpp"
+#include "pop/constraint_generation.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 Polynomial X(int i) { return Polynomial::Variable(2, i); }
@@ -132,22 +132,22 @@ std::pair<HwOuterSet, std::vector<double>> RandomSet(unsigned seed, int samples,
 
 // min / max of parameter k over orthant l with `rows` as full blocks; `checked` rows are left out of the LMI but
 // checked at its optimal moments (max_violation: the largest relative violation of their localizing matrices).
-ConstraintGenerationResult DenseBound(const HwOuterSet& set, int l, const std::vector<int>& rows,
+pop::ConstraintGenerationResult DenseBound(const HwOuterSet& set, int l, const std::vector<int>& rows,
                                       const std::vector<int>& checked, int k, bool maximize) {
-  PolyProblem core = OrthantObjectiveCore(set, l, {k, maximize ? +1 : -1});
+  pop::PolyProblem core = OrthantObjectiveCore(set, l, {k, maximize ? +1 : -1});
   const auto all = set.data_constraints(l);
   for (int i : rows) core.inequalities.push_back(all[i].g);
   std::vector<Polynomial> candidates;
   for (int i : checked) candidates.push_back(all[i].g);
-  ConstraintGenerationOptions o;
+  pop::ConstraintGenerationOptions o;
   o.order = 2;
   o.max_rounds = 1;
   o.linear_rows_first = false;
   o.verify.enabled = false;
   o.sdp.gap_tolerance = 1e-9;
   auto solver = sdp::MakeSolver("sdpa");
-  const auto r = SolveWithConstraintGeneration(o, core, candidates, {}, *solver);
-  EXPECT_EQ(r.status, RelaxationStatus::kSolved) << r.message;
+  const auto r = pop::SolveWithConstraintGeneration(o, core, candidates, {}, *solver);
+  EXPECT_EQ(r.status, pop::RelaxationStatus::kSolved) << r.message;
   return r;
 }
 
@@ -222,4 +222,4 @@ TEST(RowReduction, OneJobPerHorizonStepKeepsTheRowsOfOneJobPerOrthant) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

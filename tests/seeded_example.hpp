@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/hw_outer_set.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "dss/set_membership.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 
 inline HwOuterSet SeededSet(uint64_t seed, int samples, int horizon, double snr_db, double box = 10.0) {
   const auto ex = SimulateCeroneExample(seed, samples, snr_db);
@@ -45,4 +45,4 @@ void CompareEndpoints(const BoundsSummary& with, const BoundsSummary& without, c
   }
 }
 
-}  // namespace hw::relax
+}  // namespace hw::dss

@@ -7,9 +7,9 @@
 
 #include "core/cerone_example.hpp"
 #include "core/csv_table.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 BoundsSummary RunBounds(uint64_t seed, int samples, int horizon, int order, double snr_db, const std::string& solver = "sdpa",
@@ -108,4 +108,4 @@ TEST(SetMembership, CsdpAndSdpaGiveTheSameIntervals) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

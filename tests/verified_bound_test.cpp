@@ -9,16 +9,16 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/moment_lp.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/set_membership.hpp"
+#include "pop/constraint_generation.hpp"
+#include "pop/moment_lp.hpp"
 #include "sdp/verified_bound.hpp"
 
 namespace hw {
 namespace {
 
-using relax::MomentRelaxation;
-using relax::PolyProblem;
+using pop::MomentRelaxation;
+using pop::PolyProblem;
 
 Eigen::MatrixXd RandomOrthogonal(int n, std::mt19937& rng) {
   std::normal_distribution<double> N(0.0, 1.0);
@@ -85,7 +85,7 @@ Solved Solve(const MomentRelaxation& r, const PolyProblem& p, const std::string&
   auto solver = sdp::MakeSolver(solver_name);
   sdp::SdpOptions o;
   o.keep_dual_matrix = true;
-  return {solver->Solve(o, r.lmi()), relax::MomentVariableBounds(p, r)};
+  return {solver->Solve(o, r.lmi()), pop::MomentVariableBounds(p, r)};
 }
 
 TEST(VerifiedBound, MomentBoundsNeedTheBoxLocalizers) {
@@ -93,7 +93,7 @@ TEST(VerifiedBound, MomentBoundsNeedTheBoxLocalizers) {
   PolyProblem box = Disc(false, 0.5);
   box.inequalities.pop_back();
   MomentRelaxation rb(box, 2);
-  const auto bb = relax::MomentVariableBounds(box, rb);
+  const auto bb = pop::MomentVariableBounds(box, rb);
   ASSERT_EQ(static_cast<int>(bb.lower.size()), rb.lmi().num_vars());
   for (int i = 0; i < rb.lmi().num_vars(); ++i) {
     EXPECT_EQ(bb.lower[i], -1.0);
@@ -102,7 +102,7 @@ TEST(VerifiedBound, MomentBoundsNeedTheBoxLocalizers) {
   // With the disc x1^2 + x2^2 <= 0.5 too, the radius sqrt(0.5) bounds every moment more tightly.
   const auto p = Disc(false, 0.5);
   MomentRelaxation r(p, 2);
-  const auto b = relax::MomentVariableBounds(p, r);
+  const auto b = pop::MomentVariableBounds(p, r);
   for (int i = 0; i < r.lmi().num_vars(); ++i) {
     EXPECT_LE(b.upper[i], std::sqrt(0.5) * (1 + 1e-9));
     EXPECT_GE(b.upper[i], 0.25);  // degree <= 4: at least sqrt(0.5)^4
@@ -112,7 +112,7 @@ TEST(VerifiedBound, MomentBoundsNeedTheBoxLocalizers) {
   PolyProblem q = p;
   q.inequalities = {p.inequalities[1]};  // only 1 - x2^2 >= 0
   MomentRelaxation rq(q, 2);
-  const auto bq = relax::MomentVariableBounds(q, rq);
+  const auto bq = pop::MomentVariableBounds(q, rq);
   for (int i = 0; i < rq.lmi().num_vars(); ++i) EXPECT_TRUE(std::isinf(bq.upper[i]));
 }
 
@@ -268,7 +268,7 @@ TEST(VerifiedBound, InfeasibilityCertificates) {
   // LP screen of { x1 - 0.5 >= 0, -x1 - 0.5 >= 0 }: empty, certificate verified.
   auto solver = sdp::MakeSolver("sdpa");
   sdp::VerifiedBound cert;
-  const auto lp = relax::ScreenWithLinearProgram(
+  const auto lp = pop::ScreenWithLinearProgram(
       {Polynomial::Variable(1, 0) - Polynomial::Constant(1, 0.5), -Polynomial::Variable(1, 0) - Polynomial::Constant(1, 0.5)},
       1, {}, *solver, &cert);
   EXPECT_EQ(lp.status, sdp::SdpStatus::kInfeasible) << lp.message;
@@ -277,30 +277,30 @@ TEST(VerifiedBound, InfeasibilityCertificates) {
 
 TEST(VerifiedBound, ConstraintGenerationReportsTheVerifiedBound) {
   const auto core = Disc(false, 0.5);
-  relax::ConstraintGenerationOptions o;
+  pop::ConstraintGenerationOptions o;
   o.order = 2;
   auto solver = sdp::MakeSolver("csdp");
-  const auto r = relax::SolveWithConstraintGeneration(o, core, {}, {}, *solver);
-  ASSERT_EQ(r.status, relax::RelaxationStatus::kSolved) << r.message;
+  const auto r = pop::SolveWithConstraintGeneration(o, core, {}, {}, *solver);
+  ASSERT_EQ(r.status, pop::RelaxationStatus::kSolved) << r.message;
   ASSERT_TRUE(r.verification.verified()) << r.verification.message;
   EXPECT_EQ(r.bound, r.verification.bound);
   EXPECT_LE(r.bound, r.float_bound);
   EXPECT_LE(r.bound, -std::sqrt(0.5));
   o.verify.enabled = false;
-  const auto off = relax::SolveWithConstraintGeneration(o, core, {}, {}, *solver);
+  const auto off = pop::SolveWithConstraintGeneration(o, core, {}, {}, *solver);
   EXPECT_EQ(off.verification.status, sdp::VerifyStatus::kNotRun);
   EXPECT_EQ(off.bound, off.float_bound);
 }
 
 TEST(VerifiedBound, EverySetMembershipEndpointCarriesItsVerification) {
   const auto ex = SimulateCeroneExample(5, 40, 31.0);
-  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
-  relax::HwOuterSet set(relax::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
-  relax::BoundsOptions options;
+  dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "seeded"};
+  dss::HwOuterSet set(dss::CeroneExampleStructure(), data, 1, std::vector<std::pair<double, double>>(8, {-10.0, 10.0}));
+  dss::BoundsOptions options;
   options.order = 1;
   options.threads = 2;
   options.generation.retry_undecided_rounds = false;
-  const auto s = relax::ComputeBounds(options, set);
+  const auto s = dss::ComputeBounds(options, set);
   const auto truth = CeroneExample::TrueParameters();
   ASSERT_FALSE(s.intervals.empty());
   for (const auto& iv : s.intervals) {

@@ -1,5 +1,5 @@
 // Jobs that end once their bound passes a value a certified feasible point attains (ConstraintGenerationOptions::
-// stop_beyond, relax/edge_witness.hpp WitnessedExtremes), and jobs not run because the orthant's sign constraints
+// stop_beyond, dss/edge_witness.hpp WitnessedExtremes), and jobs not run because the orthant's sign constraints
 // already bound them beyond such a value: the bound they report stays valid, the value only comes from points
 // that are certified, and a run with the stops gives the endpoints of a run without them.
 #include <algorithm>
@@ -8,27 +8,27 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "relax/bound_jobs.hpp"
-#include "relax/constraint_generation.hpp"
-#include "relax/edge_witness.hpp"
-#include "relax/set_membership.hpp"
+#include "dss/bound_jobs.hpp"
+#include "dss/edge_witness.hpp"
+#include "dss/set_membership.hpp"
+#include "pop/constraint_generation.hpp"
 #include "seeded_example.hpp"
 
-namespace hw::relax {
+namespace hw::dss {
 namespace {
 
 // min / max of parameter k over orthant l by constraint generation over every data row, at order 2.
-ConstraintGenerationResult Solve(const HwOuterSet& set, int l, int k, bool maximize, double stop_beyond) {
-  const PolyProblem core = OrthantObjectiveCore(set, l, {k, maximize ? +1 : -1});
+pop::ConstraintGenerationResult Solve(const HwOuterSet& set, int l, int k, bool maximize, double stop_beyond) {
+  const pop::PolyProblem core = OrthantObjectiveCore(set, l, {k, maximize ? +1 : -1});
   std::vector<Polynomial> candidates;
   for (const auto& d : set.data_constraints(l)) candidates.push_back(d.g);
-  ConstraintGenerationOptions o;
+  pop::ConstraintGenerationOptions o;
   o.order = 2;
   o.stop_beyond = stop_beyond;
   o.sdp.acceptable_gap = 1e-5;
   o.sdp.infeasibility_tolerance = 0.5;
   auto solver = sdp::MakeSolver("csdp");
-  return SolveWithConstraintGeneration(o, core, candidates, {}, *solver);
+  return pop::SolveWithConstraintGeneration(o, core, candidates, {}, *solver);
 }
 
 TEST(WitnessStop, AJobEndsOnceItsVerifiedBoundPassesTheValueAndTheBoundStaysValid) {
@@ -39,13 +39,13 @@ TEST(WitnessStop, AJobEndsOnceItsVerifiedBoundPassesTheValueAndTheBoundStaysVali
   for (const bool maximize : {false, true}) {
     const double dir = maximize ? -1.0 : 1.0;  // +1: a lower bound (min)
     const auto full = Solve(set, l, a1, maximize, NAN);
-    ASSERT_EQ(full.status, RelaxationStatus::kSolved);
+    ASSERT_EQ(full.status, pop::RelaxationStatus::kSolved);
     ASSERT_GT(full.rounds, 1) << "the instance no longer needs several rounds";
     EXPECT_FALSE(full.beyond_known_value);
     // A value far inside the relaxation's bound (below it for min): an early round's bound passes it.
     const double inside = full.bound - dir * 0.5;
     const auto early = Solve(set, l, a1, maximize, inside);
-    ASSERT_EQ(early.status, RelaxationStatus::kSolved);
+    ASSERT_EQ(early.status, pop::RelaxationStatus::kSolved);
     EXPECT_TRUE(early.beyond_known_value);
     EXPECT_LT(early.rounds, full.rounds);
     EXPECT_GE(dir * early.bound, dir * inside);
@@ -164,4 +164,4 @@ TEST(WitnessStop, TheEngineGivesTheEndpointsOfARunWithoutStops) {
 }
 
 }  // namespace
-}  // namespace hw::relax
+}  // namespace hw::dss

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/progress_throttle.hpp"
-#include "relax/edge_witness.hpp"
+#include "dss/edge_witness.hpp"
 
 namespace hw::cerone {
 
@@ -18,7 +18,7 @@ bool InnerHullOptions::IsValid(std::string* error) const {
   return local.IsValid(error);
 }
 
-Witness CertifyWitness(const relax::HwOuterSet& set, std::vector<double> point) {
+Witness CertifyWitness(const dss::HwOuterSet& set, std::vector<double> point) {
   Witness w;
   if (point.size() != static_cast<std::size_t>(set.num_vars())) return w;
   for (std::size_t i = 0; i < point.size(); ++i) {
@@ -26,7 +26,7 @@ Witness CertifyWitness(const relax::HwOuterSet& set, std::vector<double> point) 
     point[i] = std::clamp(point[i], set.box()[i].first, set.box()[i].second);  // Ipopt may relax bounds by 1e-8
   }
   const int l = set.orthant_of(point);
-  const double slack = relax::CertifiedMinSlack(set, l, point);
+  const double slack = dss::CertifiedMinSlack(set, l, point);
   if (!(slack >= 0)) return w;
   w.point = std::move(point);
   w.orthant = l;
@@ -39,7 +39,7 @@ namespace {
 // The certified witnesses found so far and the local searches that produced them.
 class WitnessPool {
  public:
-  WitnessPool(const relax::HwOuterSet& set, const InnerHullOptions& options) : set_(set), options_(options) {}
+  WitnessPool(const dss::HwOuterSet& set, const InnerHullOptions& options) : set_(set), options_(options) {}
 
   // Adds the point when it certifies, found by objective `origin` (-1: none).
   void Add(const std::vector<double>& point, int origin) {
@@ -52,7 +52,7 @@ class WitnessPool {
   // `orthant` when >= 0).
   void Search(int origin, int k, int dir, const std::vector<double>& start, int orthant = -1) {
     const int l = orthant >= 0 ? orthant : set_.orthant_of(start);
-    const auto found = relax::LocalExtreme(set_, l, k, dir, start, options_.local);
+    const auto found = dss::LocalExtreme(set_, l, k, dir, start, options_.local);
     ++solves_;
     if (found.found) Add(found.point, origin);
   }
@@ -79,7 +79,7 @@ class WitnessPool {
   int solves() const { return solves_; }
 
  private:
-  const relax::HwOuterSet& set_;
+  const dss::HwOuterSet& set_;
   const InnerHullOptions& options_;
   std::vector<Witness> witnesses_;
   std::vector<int> origins_;
@@ -93,7 +93,7 @@ std::vector<std::pair<int, int>> Objectives(const std::vector<int>& params) {
   return objectives;
 }
 
-InnerInterval HullOf(const relax::HwOuterSet& set, const WitnessPool& pool, int k) {
+InnerInterval HullOf(const dss::HwOuterSet& set, const WitnessPool& pool, int k) {
   InnerInterval iv;
   iv.name = set.layout().names[k];
   iv.param = k;
@@ -109,7 +109,7 @@ InnerInterval HullOf(const relax::HwOuterSet& set, const WitnessPool& pool, int 
 
 }  // namespace
 
-InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<double>& truth,
+InnerHull ComputeInnerHull(const dss::HwOuterSet& set, const std::vector<double>& truth,
                            const std::vector<int>& params, const InnerHullOptions& options,
                            const std::vector<std::vector<double>>& given,
                            const std::function<void(const std::string&)>& progress) {
@@ -142,7 +142,7 @@ InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<doubl
   // 2. From pseudo-random points around the hull (fixed before the searches, so the order does not matter).
   const auto box = pool.WidenedHullBox();
   for (std::size_t j = 0; j < objectives.size(); ++j) {
-    for (const auto& start : relax::PseudoRandomPointsInBox(box, options.random_starts, options.seed * 1000003u + j))
+    for (const auto& start : dss::PseudoRandomPointsInBox(box, options.random_starts, options.seed * 1000003u + j))
       pool.Search(static_cast<int>(j), objectives[j].first, objectives[j].second, start);
     report("pseudo-random starts", j + 1, j + 1 == objectives.size());
   }

@@ -2,13 +2,13 @@
 // The inner hull of D^ss(n): per parameter, [min, max] over certified feasible points (inner witnesses).
 //
 // Every witness p satisfies every inequality of its own sign orthant, checked by evaluation with a rounding
-// allowance (relax::CertifiedMinSlack >= 0) and lies in the prior box, so the exact D^ss(n) interval, and every
+// allowance (dss::CertifiedMinSlack >= 0) and lies in the prior box, so the exact D^ss(n) interval, and every
 // valid outer interval at any relaxation order, contains the inner hull. The witnesses come from local
-// optimisation (relax::LocalExtreme) of each wanted parameter in both directions, started from
+// optimisation (dss::LocalExtreme) of each wanted parameter in both directions, started from
 //   1. the truth (in the truth's orthant),
 //   2. deterministic pseudo-random points in the hull found so far, widened by `spread` (in each start's orthant),
 //   3. the witness most extreme in the objective's parameter, when another objective's search found it or it
-//      was given (e.g. the bound engine's certified feasible points, relax::BoundsSummary::feasible_points);
+//      was given (e.g. the bound engine's certified feasible points, dss::BoundsSummary::feasible_points);
 // a local search from one start misses far parts of a thin set, so the hull is only ever a lower bound of the
 // exact interval.
 #include <cstdint>
@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "relax/hw_outer_set.hpp"
-#include "relax/inner_points.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "dss/inner_points.hpp"
 
 namespace hw::cerone {
 
@@ -26,14 +26,14 @@ struct InnerHullOptions {
   int restart_rounds = 1;  // rounds of restarts from other objectives' more extreme witnesses
   double spread = 0.1;     // random starts in the hull box widened by this fraction of its width on each side
   uint64_t seed = 1;       // of the starts (deterministic on every machine)
-  relax::InnerPointOptions local;
+  dss::InnerPointOptions local;
   bool IsValid(std::string* error) const;
 };
 
 struct Witness {
   std::vector<double> point;  // original units, inside the prior box
   int orthant = -1;
-  double certified_slack = 0.0;  // relax::CertifiedMinSlack at the point, >= 0
+  double certified_slack = 0.0;  // dss::CertifiedMinSlack at the point, >= 0
 };
 
 struct InnerInterval {
@@ -55,12 +55,12 @@ struct InnerHull {
 
 // The point clipped to the prior box, with its orthant and certified slack; an empty point when it is not a
 // certified feasible point of its orthant.
-Witness CertifyWitness(const relax::HwOuterSet& set, std::vector<double> point);
+Witness CertifyWitness(const dss::HwOuterSet& set, std::vector<double> point);
 
 // The inner hull of the parameters `params` (layout indices; empty = all) from `truth` (need not be feasible)
 // and the points `given` (each enters when it certifies, and is a restart point like any witness). `progress`
 // gets a line after each stage and at most every 10 s within one (at N = 1000 a hull takes minutes).
-InnerHull ComputeInnerHull(const relax::HwOuterSet& set, const std::vector<double>& truth,
+InnerHull ComputeInnerHull(const dss::HwOuterSet& set, const std::vector<double>& truth,
                            const std::vector<int>& params, const InnerHullOptions& options = {},
                            const std::vector<std::vector<double>>& given = {},
                            const std::function<void(const std::string&)>& progress = {});

@@ -8,7 +8,7 @@ std::string TableCase::label() const {
   return fmt::format("n={}, {:g} dB, seed {}, N={}", horizon, snr_db, seed, samples);
 }
 
-const relax::ParameterInterval* FindInterval(const relax::BoundsSummary& run, const std::string& name) {
+const dss::ParameterInterval* FindInterval(const dss::BoundsSummary& run, const std::string& name) {
   for (const auto& iv : run.intervals)
     if (iv.name == name) return &iv;
   return nullptr;

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "dss/set_membership.hpp"
 #include "paper_examples/cerone/inner_hull.hpp"
-#include "relax/set_membership.hpp"
 
 namespace hw::cerone {
 
@@ -21,7 +21,7 @@ struct TableCase {
   std::vector<std::string> names;  // every parameter of the layout
   std::vector<double> truth;       // in layout order
   InnerHull inner;                 // the wanted parameters
-  std::map<int, relax::BoundsSummary> outer;  // relaxation order -> the engine's run (wanted parameters)
+  std::map<int, dss::BoundsSummary> outer;  // relaxation order -> the engine's run (wanted parameters)
   // The box the outer runs started in: the prior box, or the outer intervals of horizon `box_from_horizon`.
   std::vector<std::pair<double, double>> outer_box;
   int box_from_horizon = 0;  // 0: the prior box
@@ -30,6 +30,6 @@ struct TableCase {
 };
 
 // The interval of parameter `name` in a run, or null.
-const relax::ParameterInterval* FindInterval(const relax::BoundsSummary& run, const std::string& name);
+const dss::ParameterInterval* FindInterval(const dss::BoundsSummary& run, const std::string& name);
 
 }  // namespace hw::cerone

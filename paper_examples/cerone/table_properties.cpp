@@ -27,7 +27,7 @@ bool SameData(const TableCase& a, const TableCase& b) {
 }
 
 // Checks [lo, hi] ⊆ outer up to the tolerance; a non-finite value counts as outside.
-void CheckInside(double lo, double hi, const relax::ParameterInterval& outer, double tolerance,
+void CheckInside(double lo, double hi, const dss::ParameterInterval& outer, double tolerance,
                  const std::string& property, const std::string& inner_text, const std::string& outer_text,
                  std::vector<Violation>* out) {
   const double below = outer.lower.value - lo - tolerance * std::max(1.0, std::abs(lo));

@@ -36,7 +36,7 @@ void AddOptions(CLI::App& app, CommandLine& cl, TablesOptions& o) {
   app.add_option("--endpoint-refinements", o.bounds.endpoint_refinements,
                  "times every open endpoint is solved again at full order in the box of the full pass's own bounds "
                  "(0 = never)")
-      ->check(CLI::Range(0, hw::relax::kMaxEndpointRefinements))
+      ->check(CLI::Range(0, hw::dss::kMaxEndpointRefinements))
       ->capture_default_str();
   app.add_flag("--nest-horizons,!--no-nest-horizons", o.nest_horizons,
                "start each horizon's outer runs in the box of the shorter horizon's outer intervals (default on)");

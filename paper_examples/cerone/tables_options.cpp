@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "relax/hw_outer_set.hpp"
+#include "dss/hw_outer_set.hpp"
 
 namespace hw::cerone {
 
@@ -54,13 +54,13 @@ bool ValidSnrs(const std::vector<double>& snrs, const std::string& what, std::st
 
 bool ValidRuns(const TablesOptions& o, std::string* error) {
   for (int n : o.horizons)
-    if (!relax::ValidHorizon(n, error)) return false;
+    if (!dss::ValidHorizon(n, error)) return false;
   if (o.samples < 10 * (o.horizons.empty() ? 1 : *std::max_element(o.horizons.begin(), o.horizons.end())))
     return Fail(error, fmt::format("samples: N = {} is too small for the horizons (at least 10 n)", o.samples));
   // An order below a horizon's minimal order is skipped at that horizon; it must suit the shortest one.
   const int shortest = *std::min_element(o.horizons.begin(), o.horizons.end());
   for (int d : o.orders)
-    if (!relax::ValidOrder(d, shortest, error)) return Fail(error, fmt::format("--orders: {}", *error));
+    if (!dss::ValidOrder(d, shortest, error)) return Fail(error, fmt::format("--orders: {}", *error));
   if (!IsSubset(o.outer_orders, o.orders)) return Fail(error, "--outer-orders: every order must be one of --orders");
   if (!ValidSnrs(o.snrs, "--snr-list", error) || !ValidSnrs(o.outer_snrs, "--outer-snr", error)) return false;
   if (!IsSubset(o.outer_snrs, o.snrs)) return Fail(error, "--outer-snr: every SNR must be one of --snr-list");
@@ -89,7 +89,7 @@ bool ParseSeedList(const std::string& text, const std::string& option, std::vect
 bool TablesOptions::IsValid(std::string* error) const {
   if (horizons.empty() || orders.empty()) return Fail(error, "--horizons and --orders need at least one value");
   if (!ValidRuns(*this, error)) return false;
-  const auto names = relax::MakeLayout(relax::CeroneExampleStructure()).names;
+  const auto names = dss::MakeLayout(dss::CeroneExampleStructure()).names;
   for (const auto& p : params)
     if (std::find(names.begin(), names.end(), p) == names.end())
       return Fail(error, fmt::format("--params: unknown parameter '{}' (one of {})", p, fmt::join(names, ", ")));
@@ -97,13 +97,13 @@ bool TablesOptions::IsValid(std::string* error) const {
   if (!(tolerance >= 0 && tolerance < 1e-2)) return Fail(error, "--tolerance must be in [0, 1e-2)");
   if (!inner.IsValid(error)) return false;
   if (!equivalent.IsValid(error)) return false;
-  relax::BoundsOptions check = bounds;
+  dss::BoundsOptions check = bounds;
   check.order = outer_orders.empty() ? 2 : outer_orders.front();
   return check.IsValid(error);
 }
 
 bool TablesOptions::outer_wanted(int order, int horizon, double snr) const {
-  return order >= relax::MinimalOrder(horizon) && std::count(outer_orders.begin(), outer_orders.end(), order) &&
+  return order >= dss::MinimalOrder(horizon) && std::count(outer_orders.begin(), outer_orders.end(), order) &&
          std::count(outer_snrs.begin(), outer_snrs.end(), snr);
 }
 

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "dss/set_membership.hpp"
 #include "paper_examples/cerone/equivalent_snr.hpp"
 #include "paper_examples/cerone/inner_hull.hpp"
-#include "relax/set_membership.hpp"
 
 namespace hw::cerone {
 
@@ -31,7 +31,7 @@ struct TablesOptions {
   InnerHullOptions inner;
   // The engine's settings (solver, threads, run_dir, generation.block_order_cap, verification, ...); the order
   // and parameters are set per run, and run_dir gets one subdirectory per run.
-  relax::BoundsOptions bounds;
+  dss::BoundsOptions bounds;
   bool equivalent_snr = false;
   EquivalentSnrOptions equivalent;
   uint64_t equivalent_seed = 1;

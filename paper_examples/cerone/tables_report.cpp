@@ -163,7 +163,7 @@ nlohmann::json WitnessJson(const Witness& w) {
   return {{"point", w.point}, {"orthant", w.orthant}, {"certified_slack", w.certified_slack}};
 }
 
-nlohmann::json OuterRowJson(const relax::ParameterInterval& outer, double inner_half, double paper_half) {
+nlohmann::json OuterRowJson(const dss::ParameterInterval& outer, double inner_half, double paper_half) {
   return {{"lower", outer.lower.value}, {"upper", outer.upper.value}, {"half_width", outer.half_width()},
           {"ratio_outer_inner", outer.half_width() / inner_half}, {"ratio_outer_paper", outer.half_width() / paper_half},
           {"lower_status", outer.lower.status}, {"upper_status", outer.upper.status},

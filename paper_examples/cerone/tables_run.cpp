@@ -9,13 +9,13 @@
 
 namespace hw::cerone {
 
-relax::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box) {
-  relax::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "cerone2011 example"};
-  return relax::HwOuterSet(relax::CeroneExampleStructure(), data, horizon,
+dss::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box) {
+  dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "cerone2011 example"};
+  return dss::HwOuterSet(dss::CeroneExampleStructure(), data, horizon,
                            std::vector<std::pair<double, double>>(8, {-box, box}));
 }
 
-std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vector<std::string>& names) {
+std::vector<int> ParameterIndices(const dss::HwOuterSet& set, const std::vector<std::string>& names) {
   const auto& all = set.layout().names;
   std::vector<int> indices;
   for (int k = 0; k < set.num_vars(); ++k)
@@ -26,9 +26,9 @@ std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vecto
 namespace {
 
 // The engine at one order; the orders of one case share a run cache (the order-3 run reads back the order-2 jobs).
-relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuterSet& set, const TableCase& c,
+dss::BoundsSummary RunOuter(const TablesOptions& options, const dss::HwOuterSet& set, const TableCase& c,
                               int order, const Log& log) {
-  relax::BoundsOptions bounds = options.bounds;
+  dss::BoundsOptions bounds = options.bounds;
   bounds.order = order;
   bounds.parameters = options.params;
   if (!bounds.run_dir.empty())
@@ -37,7 +37,7 @@ relax::BoundsSummary RunOuter(const TablesOptions& options, const relax::HwOuter
   // A line per finished job at most every 10 s of the phase and at its end (runs at order 3 take minutes per job;
   // screens and reductions finish hundreds of jobs a second), and the engine's messages ("resuming: ...").
   ProgressThrottle throttle(10.0);
-  auto summary = relax::ComputeBounds(bounds, set, [&](const relax::BoundsProgress& p) {
+  auto summary = dss::ComputeBounds(bounds, set, [&](const dss::BoundsProgress& p) {
     if (p.total < 0) return log("  " + p.phase);
     const bool phase_end = p.done >= p.total;
     if (p.done <= 0 || !throttle.Due(p.elapsed_seconds, phase_end)) return;

@@ -15,10 +15,10 @@ namespace hw::cerone {
 using Log = std::function<void(const std::string&)>;
 
 // D^ss(n) of a realisation in the prior box [-box, box]^8.
-relax::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box);
+dss::HwOuterSet ExampleSet(const CeroneExample& ex, int horizon, double box);
 
 // Layout indices of the named parameters (empty names: every parameter).
-std::vector<int> ParameterIndices(const relax::HwOuterSet& set, const std::vector<std::string>& names);
+std::vector<int> ParameterIndices(const dss::HwOuterSet& set, const std::vector<std::string>& names);
 
 // The box of a case's outer intervals: per parameter the intersection of its runs' intervals (each is a valid
 // outer bound) with the case's own starting box, each interval widened outward by 1e-9 of its width against

@@ -59,15 +59,15 @@ BOUNDS_CASES = [
     ({"noise_bound": 0.0}, ["--noise-bound", 0], "--noise-bound"),
     ({"noise_bound": float("inf")}, ["--noise-bound", "inf"], "--noise-bound"),
     ({"na": 0}, ["--na", 0], "na"),
-    # The prior box: Python's pairs and the CLI's text are checked by one library check (relax::ValidBoxEntry).
+    # The prior box: Python's pairs and the CLI's text are checked by one library check (dss::ValidBoxEntry).
     ({"box": (5, 1)}, ["--box", "5,1"], "--box"),
     ({"box": {"a1": (3, -3)}}, ["--box", "a1=3,-3"], "--box"),
     ({"box": {"zz": (0, 1)}}, ["--box", "zz=0,1"], "--box"),
-    # The cuts of a split box: one library check (relax::ValidBoxCuts).
+    # The cuts of a split box: one library check (dss::ValidBoxCuts).
     ({"split": {"a1": 10}}, ["--split", "a1=10"], "--split"),
     ({"split": {"zz": 0}}, ["--split", "zz=0"], "--split"),
     ({"split": {"a1": [1, 1]}}, ["--split", "a1=1,1"], "--split"),
-    # Automatic cuts: relax::ValidAutoSplitRounds.
+    # Automatic cuts: dss::ValidAutoSplitRounds.
     ({"auto_split": 6}, ["--auto-split", 6], "--auto-split"),
     ({"auto_split": -1}, ["--auto-split", -1], "--auto-split"),
 ]

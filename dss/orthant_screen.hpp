@@ -1,0 +1,26 @@
+#pragma once
+// Stage 1 of the bound engine: the LP screen of every sign orthant. Each orthant's data rows and sign
+// constraints, with every monomial a variable in [-1, 1] (even ones >= 0), form one LP (pop/moment_lp.hpp);
+// an infeasible LP, with its certificate verified, proves the orthant empty. One LP per orthant over all rows is
+// far cheaper than reducing the rows of orthants that are empty anyway, so the screen runs before the reduction;
+// the reduction would not change its verdict (a dropped row is implied in the LP too).
+#include <optional>
+#include <vector>
+
+#include "dss/bound_jobs.hpp"
+
+namespace hw::dss {
+
+struct ScreenOptions {
+  bool enabled = true;
+};
+
+struct ScreenResult {
+  std::vector<int> alive;                 // orthants not proven empty, ascending
+  std::vector<std::string> status;        // per orthant: "empty (LP)" or "undecided"
+  std::vector<std::optional<EmptinessCertificate>> certificates;  // per orthant: the LP certificate of an empty one
+};
+
+ScreenResult ScreenOrthants(const ScreenOptions& options, EngineContext& ctx);
+
+}  // namespace hw::dss

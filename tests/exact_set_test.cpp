@@ -1,0 +1,259 @@
+// The exact-set engine (exact/): safe LP bounds, the lifted relaxation, branch and bound, soundness on many
+// random systems, and bounds that hold against an LP backend that lies.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "exact/branch_and_bound.hpp"
+#include "exact/clp_solver.hpp"
+#include "exact/exact_bounds.hpp"
+#include "exact/membership.hpp"
+#include "exact/safe_bound.hpp"
+#include "random_hw.hpp"
+#include "test_support.hpp"
+
+namespace hw::exact {
+namespace {
+
+// A box around the truth: +-a_width on the a_i, +-other_width elsewhere.
+ParamBox BoxAround(const LiftedData& d, const std::vector<double>& theta, double a_width, double other_width) {
+  ParamBox box;
+  for (int k = 0; k < d.layout.count(); ++k) {
+    const bool is_a = k >= d.layout.a_begin && k < d.layout.a_begin + d.structure.na;
+    const double w = is_a ? a_width : other_width;
+    box.emplace_back(theta[k] - w, theta[k] + w);
+  }
+  return box;
+}
+
+// A random instance of exactly n samples.
+testing::RandomHwInstance InstanceOf(uint64_t seed, int samples) {
+  testing::RandomHwOptions opts;
+  opts.min_samples = samples, opts.max_samples = samples;
+  return testing::MakeRandomHwInstance(seed, opts);
+}
+
+ExactBoundsOptions SmallRunOptions() {
+  ExactBoundsOptions o;
+  o.executor = std::make_shared<sdp::InProcessExecutor>();
+  o.prune.max_levels = 4;
+  o.search.lp_budget = 3;
+  o.sweeps = 1;
+  o.inner_hull = false;
+  o.evaluation.cheap_window = 0;
+  return o;
+}
+
+TEST(SafeBound, EqualsTheLpOptimumOnASmallProblemAndNeverExceedsIt) {
+  // min x + y  s.t.  x + 2y >= 2, 3x + y >= 3, 0 <= x, y <= 10: optimum 1.4 at (0.8, 0.6).
+  LpProblem lp;
+  const int x = lp.AddColumn(0, 10), y = lp.AddColumn(0, 10);
+  lp.obj = {1.0, 1.0};
+  const int r1 = lp.AddRow(2, INFINITY), r2 = lp.AddRow(3, INFINITY);
+  lp.AddEntry(r1, x, 1), lp.AddEntry(r1, y, 2), lp.AddEntry(r2, x, 3), lp.AddEntry(r2, y, 1);
+  ClpSolver clp;
+  const LpResult r = clp.Solve(lp, {}, {});
+  ASSERT_EQ(r.status, LpStatus::kOptimal);
+  EXPECT_NEAR(r.objective, 1.4, 1e-12);
+  const double safe = SafeLowerBound(lp, r.duals);
+  EXPECT_LE(safe, 1.4 + 1e-15);
+  EXPECT_GT(safe, 1.4 - 1e-12);
+  // Any dual vector gives a valid (weaker) bound.
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> dist(-2, 2);
+  for (int trial = 0; trial < 200; ++trial) EXPECT_LE(SafeLowerBound(lp, {dist(rng), dist(rng)}), 1.4 + 1e-15);
+  // A coefficient known only to +-0.1 weakens the bound, as it must.
+  lp.entries[0].radius = 0.1;
+  EXPECT_LT(SafeLowerBound(lp, r.duals), safe);
+}
+
+TEST(LiftedLp, TheTruthsBoxIsNeverProvenEmptyAndABoxFarAwayIs) {
+  const auto inst = InstanceOf(7, 80);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  ClpSolver clp;
+  BoxEvaluationOptions ev;
+  ev.cheap_window = 30;
+  const ParamBox around = BoxAround(d, inst.theta, 1e-3, 1.0);
+  EXPECT_EQ(TestBoxEmpty(d, around, ev, clp).verdict, BoxVerdict::kKept) << inst.description;
+  ParamBox far = around;
+  far[d.layout.a_begin].lo += 0.3, far[d.layout.a_begin].hi += 0.3;
+  const BoxEvaluation e = TestBoxEmpty(d, far, ev, clp);
+  ASSERT_EQ(e.verdict, BoxVerdict::kPruned) << inst.description;
+  EXPECT_GT(e.certificate->residual_lower_bound, 0.0);
+}
+
+// An LP backend that answers "optimal" with random duals and a made-up value, or "infeasible" without duals.
+class LyingSolver : public LpSolver {
+ public:
+  explicit LyingSolver(bool claim_infeasible) : claim_infeasible_(claim_infeasible) {}
+  std::string name() const override { return "liar"; }
+  LpResult Solve(const LpProblem& p, const LpBasis&, const LpSolveOptions&) override {
+    LpResult r;
+    r.status = claim_infeasible_ ? LpStatus::kInfeasible : LpStatus::kOptimal;
+    r.objective = 1e6;
+    r.primal.assign(p.num_cols(), 0.0);
+    if (!claim_infeasible_) {
+      std::uniform_real_distribution<double> dist(-5, 5);
+      for (int i = 0; i < p.num_rows(); ++i) r.duals.push_back(dist(rng_));
+    }
+    return r;
+  }
+
+ private:
+  bool claim_infeasible_;
+  std::mt19937 rng_{3};
+};
+
+TEST(BranchAndBound, ALyingLpBackendNeitherDropsTheTruthsBoxNorExcludesTheTruth) {
+  const auto inst = InstanceOf(11, 60);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  const ParamBox start = BoxAround(d, inst.theta, 0.05, 0.5);
+  BoxEvaluationOptions ev;
+  ObjectiveSearchOptions so;
+  so.lp_budget = 6;
+  for (bool claim_infeasible : {true, false}) {
+    LyingSolver liar(claim_infeasible);
+    EXPECT_EQ(TestBoxEmpty(d, start, ev, liar).verdict, BoxVerdict::kKept);
+    for (int k = 0; k < d.layout.count(); ++k)
+      for (bool maximise : {false, true}) {
+        const auto r = SearchObjective(d, start, {start}, {k, maximise}, std::nullopt, 0.0, so, ev, liar);
+        ASSERT_FALSE(r.empty) << inst.description;
+        if (maximise) {
+          EXPECT_GE(r.bound, inst.theta[k]) << inst.description << " parameter " << k;
+        } else {
+          EXPECT_LE(r.bound, inst.theta[k]) << inst.description << " parameter " << k;
+        }
+      }
+  }
+}
+
+// Points of D found independently of the engine: the truth and random perturbations of it that the exact
+// membership LP accepts.
+std::vector<std::vector<double>> IndependentMembers(const LiftedData& d, const testing::RandomHwInstance& inst,
+                                                    const ParamBox& start, LpSolver& solver, std::mt19937& rng) {
+  std::vector<std::vector<double>> members = {inst.theta};
+  std::normal_distribution<double> step(0.0, 1.0);
+  for (int trial = 0; trial < 12; ++trial) {
+    std::vector<double> p = inst.theta;
+    const double scale = std::pow(10.0, -2.0 - trial % 3);
+    for (int k = 0; k < d.layout.count(); ++k) p[k] += scale * step(rng) * std::max(1.0, std::abs(p[k]));
+    bool inside = true;
+    for (int k = 0; k < d.layout.count(); ++k) inside = inside && start[k].contains(p[k]);
+    if (inside && CheckMembership(d, p, solver).member) members.push_back(p);
+  }
+  return members;
+}
+
+// Soundness over many seeded random systems of several structures: the truth and every independently found
+// point of D lie in every interval.
+void CheckSoundness(uint64_t first_seed, int count) {
+  int members_checked = 0;
+  std::mt19937 rng(static_cast<unsigned>(first_seed));
+  ClpSolver clp;
+  for (uint64_t seed = first_seed; seed < first_seed + static_cast<uint64_t>(count); ++seed) {
+    testing::RandomHwOptions opts;
+    opts.min_samples = 40, opts.max_samples = 70;
+    const auto inst = testing::MakeRandomHwInstance(seed, opts);
+    const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+    const ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
+    const ExactBoundsSummary s = ComputeExactBounds(SmallRunOptions(), inst.structure, inst.data, start);
+    ASSERT_FALSE(s.invalidated) << inst.description;
+    for (const auto& p : IndependentMembers(d, inst, start, clp, rng)) {
+      ++members_checked;
+      for (int k = 0; k < d.layout.count(); ++k) {
+        EXPECT_LE(s.intervals[k].lower.value, p[k]) << inst.description << " " << d.layout.names[k];
+        EXPECT_GE(s.intervals[k].upper.value, p[k]) << inst.description << " " << d.layout.names[k];
+      }
+    }
+  }
+  EXPECT_GT(members_checked, count);  // more than the truths alone
+}
+
+TEST(ExactSoundness, RandomSystemsSeeds1To25) { CheckSoundness(1, 25); }
+TEST(ExactSoundness, RandomSystemsSeeds26To50) { CheckSoundness(26, 25); }
+TEST(ExactSoundness, RandomSystemsSeeds51To75) { CheckSoundness(51, 25); }
+TEST(ExactSoundness, RandomSystemsSeeds76To100) { CheckSoundness(76, 25); }
+
+TEST(ExactBounds, NarrowerThanTheStartBoxAndTheSameOnEveryExecutor) {
+  const auto inst = InstanceOf(5, 80);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  const ParamBox start = BoxAround(d, inst.theta, 0.05, 1.0);
+  ExactBoundsOptions o = SmallRunOptions();
+  o.prune.max_levels = 6;
+  const auto in_process = ComputeExactBounds(o, inst.structure, inst.data, start);
+  o.executor = std::make_shared<sdp::ForkExecutor>(2);
+  const auto forked = ComputeExactBounds(o, inst.structure, inst.data, start);
+  ASSERT_EQ(in_process.intervals.size(), forked.intervals.size());
+  for (std::size_t k = 0; k < forked.intervals.size(); ++k) {
+    EXPECT_EQ(in_process.intervals[k].lower.value, forked.intervals[k].lower.value);
+    EXPECT_EQ(in_process.intervals[k].upper.value, forked.intervals[k].upper.value);
+  }
+  const int a1 = d.layout.a_begin;
+  EXPECT_LT(forked.intervals[a1].upper.value - forked.intervals[a1].lower.value, 0.5 * start[a1].hi - 0.5 * start[a1].lo);
+  EXPECT_TRUE(forked.assumption.holds) << forked.assumption.smallest_increase;
+}
+
+TEST(ExactBounds, ARecordNoModelOfTheClassExplainsIsInvalidatedWithCertificates) {
+  auto inst = InstanceOf(9, 60);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  // The start box excludes the truth's a_1 by far: nothing in it explains the record.
+  ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
+  start[d.layout.a_begin] = Interval(inst.theta[d.layout.a_begin] + 0.5, inst.theta[d.layout.a_begin] + 0.6);
+  const auto s = ComputeExactBounds(SmallRunOptions(), inst.structure, inst.data, start);
+  EXPECT_TRUE(s.invalidated);
+  EXPECT_FALSE(s.certificates.empty());
+  for (const auto& c : s.certificates) EXPECT_GT(c.at("certificate").at("residual_lower_bound").get<double>(), 0.0);
+}
+
+#ifdef HW_CLI_PATH
+TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
+  testing::RandomHwOptions opts;
+  opts.min_samples = 80, opts.max_samples = 80;
+  testing::RandomHwInstance inst;
+  for (uint64_t seed = 1;; ++seed) {  // the first instance of the example's class (na = nb = 1, poly:1 input)
+    inst = testing::MakeRandomHwInstance(seed, opts);
+    if (inst.structure.na == 1 && inst.structure.nb == 1 && inst.structure.strictly_proper &&
+        inst.structure.input_basis.size() == 1 && inst.structure.output_basis.size() == 2)
+      break;
+  }
+  const std::string csv = ::testing::TempDir() + "exact_cli.csv", json = ::testing::TempDir() + "exact_cli.json";
+  {
+    std::ofstream out(csv);
+    out << "u,y,dy\n";
+    out.precision(17);
+    for (std::size_t t = 0; t < inst.data.y.size(); ++t)
+      out << inst.data.u[t] << "," << inst.data.y[t] << "," << inst.data.noise_bound[t] << "\n";
+  }
+  std::string truth;
+  for (double v : inst.theta) truth += (truth.empty() ? "" : ",") + fmt::format("{:.17g}", v);
+  const auto run = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --na 1 --nb 1 --input-basis poly:1 "
+                                      "--output-basis poly:2 --horizon 1 --set exact --lp-budget 4 --sweeps 1 "
+                                      "--threads 1 --quiet --truth {} --json {}",
+                                      csv, truth, json));
+  ASSERT_EQ(run.code, 0) << inst.description << "\n" << run.output;
+  EXPECT_NE(run.output.find("exact set D"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("increases on the data range"), std::string::npos) << run.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("set"), "exact");
+  EXPECT_TRUE(j.at("truth_covered").get<bool>());
+  EXPECT_EQ(j.at("outer_set_intervals").size(), j.at("intervals").size());
+  EXPECT_TRUE(j.at("assumption").at("holds").get<bool>());
+  EXPECT_GT(j.at("stage2").at("lps").get<int>(), 0);
+  for (const auto& iv : j.at("intervals")) {
+    EXPECT_EQ(iv.at("lower").at("verification"), "verified");
+    EXPECT_TRUE(iv.contains("inner")) << iv.dump();
+  }
+  // An unknown set is refused before any work.
+  const auto bad = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --set exactly", csv));
+  EXPECT_EQ(bad.code, 2) << bad.output;
+}
+#endif
+
+}  // namespace
+}  // namespace hw::exact
