@@ -156,7 +156,7 @@ TEST(ConstraintGeneration, AnUndecidedRoundGoesToTheOtherBackendOnlyWhenAsked) {
   EXPECT_LE(retried.bound, -std::sqrt(0.5) + 1e-9);
 }
 
-TEST(pop::LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
+TEST(LinearProgramBound, BoundsAVariableAndDetectsEmptiness) {
   auto solver = sdp::MakeSolver("csdp");
   // x1 >= 0.5 and x1 + x2 <= 0.2 inside [-1, 1]^2: x1 in [0.5, 1], x2 <= -0.3.
   std::vector<Polynomial> cons = {Polynomial::Variable(2, 0) - Polynomial::Constant(2, 0.5),
