@@ -1,9 +1,9 @@
 #pragma once
 // How `hwbounds bounds` shows a long run's progress to a person: on a terminal one line per phase, rewritten in
 // place (jobs done/total, ETA) and left standing when the phase ends; elsewhere (a pipe, a log file) plain lines
-// at a phase's end and, in between, whenever the phase's time has doubled since the last line (10, 20, 40 s, ...,
-// then every 10 min), so that a phase gives a handful of lines on a slow or busy machine as on a fast one; or
-// nothing at all.
+// at a phase's end and, in between, from 1 min on whenever the phase's time has doubled since the last line (1, 2,
+// 4, 8 min, ..., then every 10 min), so that a phase gives a handful of lines on a slow or busy machine as on a
+// fast one; or nothing at all.
 #include <cstdio>
 #include <string>
 
@@ -24,7 +24,7 @@ class ProgressDisplay {
  public:
   // A phase's first plain line comes after `first_line_seconds`; the gap to the next one is the time elapsed so
   // far, at most `longest_gap_seconds`.
-  ProgressDisplay(ProgressMode mode, std::FILE* out, double first_line_seconds = 10.0, double longest_gap_seconds = 600.0);
+  ProgressDisplay(ProgressMode mode, std::FILE* out, double first_line_seconds = 60.0, double longest_gap_seconds = 600.0);
   ~ProgressDisplay();
   ProgressDisplay(const ProgressDisplay&) = delete;
   ProgressDisplay& operator=(const ProgressDisplay&) = delete;
