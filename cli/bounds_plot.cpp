@@ -94,7 +94,7 @@ std::string Script(const dss::BoundsSummary& s, bool with_truth, const std::stri
       "set output 'plot.png'\n"
       "set datafile missing '?'\n"
       "set multiplot layout 1,2 title {}\n"
-      "set yrange [-0.8:{}]\nset grid xtics\nset key below\nset bars 3\n",
+      "set yrange [-0.8:{}]\nset grid xtics\nset key below horizontal maxrows 2\n",
       terminal, 180 + 48 * n, Quoted(title), n - 0.2);
   const std::string truth = with_truth ? ", 'intervals.dat' using 6:1 with points pt 13 ps 2 lc rgb '#d62728' title 'truth'" : "";
   gp += "set title 'in the prior box (0: its lower edge, 1: its upper edge)'\nset xrange [-0.05:1.05]\n";
@@ -102,13 +102,14 @@ std::string Script(const dss::BoundsSummary& s, bool with_truth, const std::stri
         "'' using 4:1:($5-$4):(0) with vectors nohead lw 7 lc rgb '#1f77b4' title 'guaranteed interval', "
         "'' using 4:1 with points pt 5 ps 0.8 lc rgb '#1f77b4' notitle, "
         "'' using 5:1 with points pt 5 ps 0.8 lc rgb '#1f77b4' notitle, "
-        "'points.dat' using 2:1 with points pt 7 ps 0.7 lc rgb '#2ca02c' title 'certified feasible points'" +
+        "'points.dat' using 2:($1+0.25) with points pt 7 ps 0.6 lc rgb '#2ca02c' title 'certified feasible points'" +
         truth + "\n";
   const std::string truth_in = with_truth ? ", 'intervals.dat' using 9:1 with points pt 13 ps 2 lc rgb '#d62728' title 'truth'" : "";
-  gp += "set title 'within each interval (0: its lower end, 1: its upper end)'\nset xrange [-0.1:1.1]\n";
+  gp += "set title 'within each interval (0: its lower end, 1: its upper end)'\nset xrange [-0.1:1.1]\n"
+        "set key below vertical maxrows 3\n";  // one column: it fits the panel's width
   gp += "plot 'intervals.dat' using (0):1:(1):(0):ytic(3) with vectors nohead lw 7 lc rgb '#1f77b4' title 'guaranteed interval', "
-        "'' using 7:1:($8-$7):(0) with vectors nohead lw 3 lc rgb '#2ca02c' title 'feasible points reach', "
-        "'points.dat' using 3:1 with points pt 7 ps 0.7 lc rgb '#2ca02c' notitle" +
+        "'' using 7:($1+0.25):($8-$7):(0) with vectors nohead lw 3 lc rgb '#2ca02c' title 'feasible points reach', "
+        "'points.dat' using 3:($1+0.25) with points pt 7 ps 0.6 lc rgb '#2ca02c' notitle" +
         truth_in + "\n";
   gp += "unset multiplot\n";
   return gp;

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 namespace hw::cli {
@@ -25,8 +27,9 @@ std::string ProgressLine(const dss::BoundsProgress& p) {
                      p.elapsed_seconds, p.eta_seconds);
 }
 
-ProgressDisplay::ProgressDisplay(ProgressMode mode, std::FILE* out, double plain_interval_seconds)
-    : mode_(mode), out_(out), throttle_(plain_interval_seconds) {}
+ProgressDisplay::ProgressDisplay(ProgressMode mode, std::FILE* out, double first_line_seconds,
+                                 double longest_gap_seconds)
+    : mode_(mode), out_(out), first_line_seconds_(first_line_seconds), longest_gap_seconds_(longest_gap_seconds) {}
 
 ProgressDisplay::~ProgressDisplay() { Finish(); }
 
@@ -35,10 +38,20 @@ void ProgressDisplay::Show(const dss::BoundsProgress& p) {
   if (p.total < 0) return ShowMessage(p.phase);
   const std::string line = ProgressLine(p);
   if (mode_ == ProgressMode::kLive) return ShowLive(p, line);
-  // Each phase's clock starts at 0, and its first line is a boundary, so the throttle needs no reset.
-  if (!throttle_.Due(p.elapsed_seconds, p.done <= 0 || PhaseEnds(p))) return;
+  if (!PlainLineDue(p)) return;
   fmt::print(out_, "{}\n", line);
   std::fflush(out_);
+}
+
+bool ProgressDisplay::PlainLineDue(const dss::BoundsProgress& p) {
+  if (p.phase != plain_phase_ || p.done <= 0) {  // a phase starts: its clock is at 0
+    plain_phase_ = p.phase;
+    next_plain_line_ = first_line_seconds_;
+  }
+  if (PhaseEnds(p)) return true;
+  if (p.done <= 0 || p.elapsed_seconds < next_plain_line_) return false;
+  next_plain_line_ = p.elapsed_seconds + std::min(std::max(p.elapsed_seconds, first_line_seconds_), longest_gap_seconds_);
+  return true;
 }
 
 void ProgressDisplay::ShowLive(const dss::BoundsProgress& p, const std::string& line) {

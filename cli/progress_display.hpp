@@ -1,11 +1,12 @@
 #pragma once
 // How `hwbounds bounds` shows a long run's progress to a person: on a terminal one line per phase, rewritten in
 // place (jobs done/total, ETA) and left standing when the phase ends; elsewhere (a pipe, a log file) plain lines
-// at a phase's start and end and at most one per interval in between; or nothing at all.
+// at a phase's end and, in between, from 1 min on whenever the phase's time has doubled since the last line (1, 2,
+// 4, 8 min, ..., then every 10 min), so that a phase gives a handful of lines on a slow or busy machine as on a
+// fast one; or nothing at all.
 #include <cstdio>
 #include <string>
 
-#include "core/progress_throttle.hpp"
 #include "dss/set_membership.hpp"
 
 namespace hw::cli {
@@ -21,8 +22,9 @@ ProgressMode ChooseProgressMode(std::FILE* out, bool quiet, bool verbose);
 
 class ProgressDisplay {
  public:
-  // Plain lines come at most one per `plain_interval_seconds` within a phase (its first and last always).
-  ProgressDisplay(ProgressMode mode, std::FILE* out, double plain_interval_seconds = 10.0);
+  // A phase's first plain line comes after `first_line_seconds`; the gap to the next one is the time elapsed so
+  // far, at most `longest_gap_seconds`.
+  ProgressDisplay(ProgressMode mode, std::FILE* out, double first_line_seconds = 60.0, double longest_gap_seconds = 600.0);
   ~ProgressDisplay();
   ProgressDisplay(const ProgressDisplay&) = delete;
   ProgressDisplay& operator=(const ProgressDisplay&) = delete;
@@ -34,10 +36,13 @@ class ProgressDisplay {
  private:
   void ShowMessage(const std::string& text);
   void ShowLive(const dss::BoundsProgress& p, const std::string& line);
+  bool PlainLineDue(const dss::BoundsProgress& p);
 
   ProgressMode mode_;
   std::FILE* out_;
-  ProgressThrottle throttle_;
+  double first_line_seconds_, longest_gap_seconds_;
+  std::string plain_phase_;  // the phase the next plain line is timed for (kPlain)
+  double next_plain_line_ = 0.0;  // its elapsed time at which a line is due
   std::string live_phase_;  // the phase whose line is open (kLive); empty: none
 };
 

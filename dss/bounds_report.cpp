@@ -177,6 +177,7 @@ void AppendRunSummary(std::string& out, const BoundsSummary& summary, bool verif
   if (summary.jobs_settled_by_sign > 0)
     fmt::format_to(std::back_inserter(out), "{} relaxation job(s) not run: the orthant's sign constraints already bound them at or beyond a "
                "certified feasible point's value\n", summary.jobs_settled_by_sign);
+  std::string reductions;  // one line for every live orthant: "orthant 48: step 1: 213 of 596, ...; orthant 49: ..."
   for (const auto& r : summary.row_reduction) {
     std::string steps;
     for (const auto& c : r.at("per_step"))
@@ -190,8 +191,9 @@ void AppendRunSummary(std::string& out, const BoundsSummary& summary, bool verif
                                  ? fmt::format(" ({} kept after their LP hit the simplex iteration limit)",
                                                c.at("iteration_limited").get<int>())
                                  : std::string());
-    fmt::format_to(std::back_inserter(out), "exact row reduction, orthant {}: data rows kept {}\n", r.at("orthant").get<int>(), steps);
+    reductions += fmt::format("{}orthant {}: {}", reductions.empty() ? "" : "; ", r.at("orthant").get<int>(), steps);
   }
+  if (!reductions.empty()) fmt::format_to(std::back_inserter(out), "exact row reduction, data rows kept: {}\n", reductions);
   if (!summary.bound_sources.empty()) {
     std::string sources;
     for (const auto& [what, count] : ByName(summary.bound_sources))
