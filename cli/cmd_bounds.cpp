@@ -100,6 +100,9 @@ struct BoundsCliOptions {
 
 // What the bounds of the exact set D need besides the D^ss(n) run: its start box is that run's result.
 exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss::BoundsOptions& dss) {
+  if (o.lp_budget < 1)
+    throw InputError(fmt::format("--lp-budget {}: LPs per endpoint refinement must be at least 1", o.lp_budget));
+  if (o.sweeps < 1 || o.sweeps > 5) throw InputError(fmt::format("--sweeps {}: expected 1..5", o.sweeps));
   exact::ExactBoundsOptions options;
   options.executor = dss.executor;
   options.run_dir = o.run_dir;
@@ -316,6 +319,7 @@ void AddBoundsCommand(CLI::App& app) {
     const dss::HwStructure structure = ReadStructure(*o);
     const auto names = dss::MakeLayout(structure).names;
     const dss::BoundsOptions options = MakeBoundsOptions(*o);
+    if (o->set == "exact") MakeExactOptions(*o, options);  // its settings refused before any work
     const dss::HwOuterSet set(structure, data, o->horizon, parse_box(o->box, names));
     const std::vector<dss::BoxCut> cuts = parse_split(o->split);
     RequireOption("--split", [&](std::string* e) { return dss::ValidBoxCuts(cuts, names, set.box(), e); });

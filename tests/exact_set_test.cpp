@@ -252,6 +252,14 @@ TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
   // An unknown set is refused before any work.
   const auto bad = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --set exactly", csv));
   EXPECT_EQ(bad.code, 2) << bad.output;
+  // So are the exact stage's settings, before stage 1 runs.
+  const auto zero = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --na 1 --nb 1 --input-basis "
+                                                        "poly:1 --output-basis poly:2 --horizon 1 --set exact "
+                                                        "--lp-budget 0",
+                                                        csv));
+  EXPECT_EQ(zero.code, 2) << zero.output;
+  EXPECT_NE(zero.output.find("--lp-budget 0"), std::string::npos) << zero.output;
+  EXPECT_EQ(zero.output.find("orthants"), std::string::npos) << zero.output;
 }
 #endif
 
