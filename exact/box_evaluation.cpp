@@ -52,8 +52,6 @@ int RatioDenominator(const LiftedData& data, const ParamBox& box) {
 
 }  // namespace
 
-std::string Objective::name() const { return fmt::format("{} #{}", maximise ? "max" : "min", parameter); }
-
 nlohmann::json PruneCertificate::to_json() const {
   return {{"window", {window.begin, window.end}}, {"residual_lower_bound", residual_lower_bound}};
 }

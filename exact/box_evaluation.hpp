@@ -28,7 +28,6 @@ struct PruneCertificate {
 struct Objective {
   int parameter = 0;
   bool maximise = false;
-  std::string name() const;  // "min a1"
 };
 
 struct BoxEvaluationOptions {

@@ -27,7 +27,7 @@ class JobRunner {
                                   const std::function<void(int, int)>& on_done = {}) {
     std::vector<nlohmann::json> answers(specs.size());
     std::vector<std::string> texts, keys;
-    std::vector<std::size_t> todo;
+    std::vector<std::size_t> to_run;  // indices of specs not answered by the run directory
     for (std::size_t i = 0; i < specs.size(); ++i) {
       const std::string text = specs[i].dump();
       const std::string key = JobKey(text);
@@ -38,17 +38,17 @@ class JobRunner {
       }
       texts.push_back(text);
       keys.push_back(key);
-      todo.push_back(i);
+      to_run.push_back(i);
     }
-    int done = static_cast<int>(specs.size() - todo.size());
+    int done = static_cast<int>(specs.size() - to_run.size());
     const auto results = executor_.Map(texts, fn_, [&](std::size_t, const sdp::JobResult&) {
       if (on_done) on_done(++done, static_cast<int>(specs.size()));
     });
-    for (std::size_t n = 0; n < todo.size(); ++n) {
+    for (std::size_t n = 0; n < to_run.size(); ++n) {
       ++summary_.jobs;
       if (!results[n].ok) continue;  // stays null
-      answers[todo[n]] = nlohmann::json::parse(results[n].text);
-      cache_.store(keys[n], answers[todo[n]]);
+      answers[to_run[n]] = nlohmann::json::parse(results[n].text);
+      cache_.store(keys[n], answers[to_run[n]]);
     }
     return answers;
   }
