@@ -169,11 +169,12 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
       end.status = EndpointStatus::kEmpty;
       continue;
     }
-    // Keep the tighter of two valid bounds (an earlier sweep's, this one's).
+    // Keep the tighter of two valid bounds (an earlier sweep's, this one's); an LP bound equal to a box edge
+    // makes that edge guaranteed.
     const bool tighter = obj.maximise ? r.bound < end.value : r.bound > end.value;
-    if (tighter || end.status == EndpointStatus::kConservative) {
-      if (tighter) end.value = r.bound;
-      end.status = r.from_lp || !tighter ? (r.from_lp ? EndpointStatus::kGuaranteed : end.status) : EndpointStatus::kConservative;
+    if (tighter || (r.bound == end.value && r.from_lp)) {
+      end.value = r.bound;
+      end.status = r.from_lp ? EndpointStatus::kGuaranteed : EndpointStatus::kConservative;
       end.correction = std::abs(r.bound - r.lp_value);
     }
   }
