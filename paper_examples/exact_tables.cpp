@@ -5,6 +5,7 @@
 // the ratios, with the stage-2 counts and time (the stage-1 time is the committed run's).
 //
 //   exact_tables --tables paper_examples/results/cerone_n23_snr31_delta3/tables.json --out DIR [--threads 2]
+//   exact_tables --summarise DIR1 DIR2 ... --summary-out FILE.md   (one table over earlier runs)
 #include <cmath>
 #include <fstream>
 
@@ -86,18 +87,108 @@ std::string Table(const exact::ExactBoundsSummary& s, const StageOne& one, const
   return md;
 }
 
+// The order δ of the committed run whose n = 2 intervals are `start_box` (the box a run of this program started
+// from), or 0 when none matches.
+int OrderOfStartBox(const std::string& tables, const exact::ParamBox& start_box) {
+  std::ifstream in(tables);
+  if (!in) return 0;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  for (const auto& c : j.at("cases")) {
+    if (c.at("n").get<int>() != 2) continue;
+    for (const auto& [order, run] : c.at("outer_runs").items()) {
+      const auto& ivs = run.at("intervals");
+      bool same = ivs.size() == start_box.size();
+      for (std::size_t k = 0; same && k < ivs.size(); ++k)
+        same = ivs[k].at("lower").at("value").get<double>() == start_box[k].lo &&
+               ivs[k].at("upper").at("value").get<double>() == start_box[k].hi;
+      if (same) return std::stoi(order);
+    }
+  }
+  return 0;
+}
+
+// One table over several runs of this program (DIR/exact.json each; run from the repository root, where the
+// runs' stage-1 paths are relative to): per parameter and realisation, outer/inner
+// and the exact interval's width against the paper's Table I and against D^ss(2); then each run's counts.
+std::string Summary(const std::vector<std::string>& dirs) {
+  struct Run {
+    std::string dir;
+    nlohmann::json j;
+    int order = 0;
+  };
+  std::vector<Run> runs;
+  for (const auto& d : dirs) {
+    std::ifstream in(d + "/exact.json");
+    if (!in) throw InputError(fmt::format("{}/exact.json: cannot read", d));
+    Run r{d, nlohmann::json::parse(in)};
+    r.order = OrderOfStartBox(r.j.at("stage1").at("tables").get<std::string>(), exact::BoxFromJson(r.j.at("start_box")));
+    runs.push_back(std::move(r));
+  }
+  auto realisation = [](const Run& r) {
+    const auto& z = r.j.at("realisation");
+    return fmt::format("seed {}, {:g} dB", z.at("seed").get<int>(), z.at("snr_db").get<double>());
+  };
+  std::string md = "Each cell: outer/inner · exact width / paper Table I width · exact width / D^ss(2) width.\n\n| parameter |";
+  for (const auto& r : runs) md += fmt::format(" {} |", realisation(r));
+  md += "\n|---|";
+  for (std::size_t i = 0; i < runs.size(); ++i) md += "---|";
+  md += "\n";
+  const auto truth = CeroneExample::TrueParameters();
+  const std::size_t n = runs.front().j.at("intervals").size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string name = runs.front().j.at("intervals")[k].at("name").get<std::string>();
+    md += "| " + name + " |";
+    for (const auto& r : runs) {
+      const auto& iv = r.j.at("intervals")[k];
+      const double lo = iv.at("lower").at("value").get<double>(), hi = iv.at("upper").at("value").get<double>();
+      const auto& inner = iv.at("inner");
+      const auto& box = r.j.at("start_box")[k];
+      const auto paper = cerone::PaperTableInterval(name, 2);
+      const bool inside = lo <= truth[k] && truth[k] <= hi;
+      md += fmt::format(" {:.2f} · {} · {:.3g}{} |", (hi - lo) / (inner[1].get<double>() - inner[0].get<double>()),
+                        paper ? fmt::format("{:.3g}", (hi - lo) / (paper->upper - paper->lower)) : "-",
+                        (hi - lo) / (box[1].get<double>() - box[0].get<double>()), inside ? "" : " **truth outside**");
+    }
+    md += "\n";
+  }
+  md += "\n| run | start box | stage 2 wall | LPs (not optimal) | levels, boxes pruned | assumption |\n|---|---|---|---|---|---|\n";
+  for (const auto& r : runs) {
+    const auto& s2 = r.j.at("stage2");
+    md += fmt::format("| [{}]({}/exact_table.md) | {} | {:.0f} s on {} | {} ({}) | {}, {} | {} |\n",
+                      realisation(r), r.dir.substr(r.dir.find_last_of('/') + 1),
+                      r.order ? fmt::format("D^ss(2) at δ = {}", r.order) : std::string("no committed D^ss(2) run matches"),
+                      s2.at("wall_seconds").get<double>(), s2.at("executor").get<std::string>(), s2.at("lps").get<int>(),
+                      s2.at("lp_failures").get<int>(), s2.at("prune_levels").get<int>(), s2.at("boxes_pruned").get<int>(),
+                      r.j.at("assumption").at("holds").get<bool>() ? "holds" : "not shown");
+  }
+  return md;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Exact-set intervals against the paper's Table I on a committed realisation"};
   std::string tables, out;
   int threads = 2, lp_budget = exact::ObjectiveSearchOptions{}.lp_budget;
-  app.add_option("--tables", tables, "a committed cerone_tables result (tables.json) with an n = 2 case")->required();
-  app.add_option("--out", out, "output folder")->required();
+  std::vector<std::string> summarise;
+  std::string summary_out;
+  app.add_option("--tables", tables, "a committed cerone_tables result (tables.json) with an n = 2 case");
+  app.add_option("--out", out, "output folder");
+  app.add_option("--summarise", summarise, "folders of earlier runs (each with exact.json): one table over them")
+      ->excludes("--tables");
+  app.add_option("--summary-out", summary_out, "with --summarise: the Markdown file to write");
   app.add_option("--threads", threads, "fork workers");
   app.add_option("--lp-budget", lp_budget, "LPs per endpoint refinement");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (!summarise.empty()) {
+      if (summary_out.empty()) throw InputError("--summarise needs --summary-out FILE.md");
+      const std::string md = Summary(summarise);
+      write_text_atomic(summary_out, md);
+      fmt::print("{}", md);
+      return 0;
+    }
+    if (tables.empty() || out.empty()) throw InputError("--tables and --out are required (or --summarise DIR...)");
     const StageOne one = ReadStageOne(tables);
     const CeroneExample ex = SimulateCeroneExample(one.seed, one.samples, one.snr_db);
     dss::HwData data;
