@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <tuple>
 
 namespace hw::dss {
 namespace {
@@ -14,13 +15,28 @@ double now_seconds() {
 
 ProgressReporter::ProgressReporter(std::function<void(const BoundsProgress&)> sink) : sink_(std::move(sink)) {}
 
+BoundsProgress ProgressReporter::Event() const {
+  const double elapsed = now_seconds() - phase_start_;
+  BoundsProgress p{phase_, done_, total_, from_cache_, elapsed, done_ > 0 ? elapsed / done_ * (total_ - done_) : 0.0};
+  if (const auto it = so_far_.find(last_bounded_); it != so_far_.end()) {
+    p.so_far_parameter = last_bounded_;
+    std::tie(p.so_far_lower, p.so_far_upper) = it->second;
+  }
+  return p;
+}
+
 void ProgressReporter::Phase(const std::string& name, int total) {
   phase_ = name;
   done_ = 0;
   total_ = total;
   from_cache_ = uncounted_ = 0;
   phase_start_ = now_seconds();
-  if (sink_ && total > 0) sink_({phase_, 0, total_, 0, 0.0, 0.0});
+  so_far_.clear();
+  last_bounded_.clear();
+  if (!sink_ || total <= 0) return;
+  BoundsProgress p = Event();
+  p.elapsed_seconds = 0.0;
+  sink_(p);
 }
 
 void ProgressReporter::FromCache(int jobs) {
@@ -28,7 +44,10 @@ void ProgressReporter::FromCache(int jobs) {
   total_ = std::max(0, total_ - jobs);
   from_cache_ += jobs;
   uncounted_ += jobs;
-  if (sink_) sink_({phase_, done_, total_, from_cache_, now_seconds() - phase_start_, 0.0});
+  if (!sink_) return;
+  BoundsProgress p = Event();
+  p.eta_seconds = 0.0;
+  sink_(p);
 }
 
 void ProgressReporter::Done(int jobs) {
@@ -37,9 +56,14 @@ void ProgressReporter::Done(int jobs) {
   jobs -= skip;
   if (jobs <= 0) return;
   done_ += jobs;
-  if (!sink_) return;
-  const double el = now_seconds() - phase_start_;
-  sink_({phase_, done_, total_, from_cache_, el, done_ > 0 ? el / done_ * (total_ - done_) : 0.0});
+  if (sink_) sink_(Event());
+}
+
+void ProgressReporter::Bound(const std::string& parameter, int dir, double value) {
+  auto& [lower, upper] = so_far_[parameter];
+  if (dir < 0) lower = std::min(lower.value_or(value), value);
+  else upper = std::max(upper.value_or(value), value);
+  last_bounded_ = parameter;
 }
 
 void ProgressReporter::Message(const std::string& text) {

@@ -169,6 +169,8 @@ std::vector<JobOutcome> RunRelaxationJobs(EngineContext& ctx, const std::vector<
         o.ProveEmpty({CertificateKind::kRelaxation, jobs[i].order, o.box != ctx.set.box(),
                       out.verification == sdp::VerifyStatus::kVerified});
     }
+    if (out.status == JobStatus::kSolved)
+      ctx.progress.Bound(ctx.set.layout().names[jobs[i].objective.param], jobs[i].objective.dir, out.bound);
     ctx.progress.Done();
   });
   return outs;
