@@ -2,11 +2,11 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 
 #include <fmt/format.h>
 
 #include "core/atomic_write.hpp"
+#include "core/json_input.hpp"
 
 namespace hw::dss {
 namespace fs = std::filesystem;
@@ -22,12 +22,10 @@ constexpr const char* kPlanFile = "planned.json";
 
 // The job keys in a plan file, or nothing when it is missing or damaged (then its count is not trusted).
 std::optional<std::set<std::string>> ReadPlannedJobs(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) return std::nullopt;
+  const auto j = ReadStoredJson(file.string());
+  if (!j) return std::nullopt;
   try {
-    nlohmann::json j;
-    in >> j;
-    return j.at("planned_jobs").get<std::set<std::string>>();
+    return j->at("planned_jobs").get<std::set<std::string>>();
   } catch (...) {
     return std::nullopt;
   }
@@ -50,15 +48,7 @@ RunCache::RunCache(const std::string& root, const std::string& key, const nlohma
 
 std::optional<nlohmann::json> RunCache::load(const std::string& name) const {
   if (!enabled()) return std::nullopt;
-  std::ifstream in(fs::path(dir_) / "jobs" / (name + ".json"));
-  if (!in) return std::nullopt;
-  try {
-    nlohmann::json j;
-    in >> j;
-    return j;
-  } catch (...) {
-    return std::nullopt;
-  }
+  return ReadStoredJson((fs::path(dir_) / "jobs" / (name + ".json")).string());
 }
 
 void RunCache::store(const std::string& name, const nlohmann::json& j) const {
