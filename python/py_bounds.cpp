@@ -91,9 +91,6 @@ py::dict ProgressDict(const dss::BoundsProgress& p) {
   d["elapsed_seconds"] = p.elapsed_seconds;
   d["eta_seconds"] = p.eta_seconds;
   d["from_cache"] = p.from_cache;
-  d["so_far_parameter"] = p.so_far_parameter;
-  d["so_far_lower"] = p.so_far_lower ? py::object(py::float_(*p.so_far_lower)) : py::object(py::none());
-  d["so_far_upper"] = p.so_far_upper ? py::object(py::float_(*p.so_far_upper)) : py::object(py::none());
   return d;
 }
 
@@ -260,10 +257,8 @@ and the intervals are the hull over the pieces (each piece's own result under "p
 auto_split: the CLI's --auto-split, 0..5 rounds: after the run, the box shrunk to the verified intervals is cut
 just beyond the last certified feasible point of the largest unwitnessed part and bounded again (each round's
 box, cut and intervals under "auto_split").
-progress: called as progress(dict(phase, done, total, from_cache, elapsed_seconds, eta_seconds, so_far_parameter,
-so_far_lower, so_far_upper)) after each job (done/total count the jobs still to run; from_cache those read from
-run_dir; so_far_*: the parameter a relaxation job of the phase bounded last and its interval over the phase's
-finished jobs, None for a side not bounded yet, "" when none).
+progress: called as progress(dict(phase, done, total, from_cache, elapsed_seconds, eta_seconds)) after each job
+(done/total count the jobs still to run; from_cache those read from run_dir).
 Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verification), prior_box, orthants,
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
 its worker processes; with run_dir a rerun resumes from the finished jobs.
