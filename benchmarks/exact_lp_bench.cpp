@@ -64,9 +64,18 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats)->check(CLI::PositiveNumber);
   app.add_option("--window", window, "samples of the short window");
   app.add_option("--box", box_file, "an exact.json whose start_box is the box");
+  bool final_box = false;
+  app.add_flag("--final-box", final_box, "the run's final intervals as the box (a late box of the search) instead "
+                                         "of its start box");
   CLI11_PARSE(app, argc, argv);
   std::ifstream in(box_file);
-  const ParamBox box = BoxFromJson(nlohmann::json::parse(in).at("start_box"));
+  const nlohmann::json run = nlohmann::json::parse(in);
+  ParamBox box = BoxFromJson(run.at("start_box"));
+  if (final_box) {
+    box.clear();
+    for (const auto& iv : run.at("intervals"))
+      box.emplace_back(iv.at("lower").at("value").get<double>(), iv.at("upper").at("value").get<double>());
+  }
   const auto ex = hw::SimulateCeroneExample(seed, samples, snr);
   hw::dss::HwData data{ex.u, ex.y, std::vector<double>(ex.y.size(), ex.noise_bound), "bench"};
   const LiftedData lifted = MakeLiftedData(hw::dss::CeroneExampleStructure(), data);
@@ -78,7 +87,7 @@ int main(int argc, char** argv) {
   child.SetSlackObjective();
   LiftedLp bounding = BuildLiftedLp(lifted, box, WholeRecord(lifted), LiftedForm::kBounding);
   std::vector<double> weights(lifted.layout.count(), 0.0);
-  weights[alpha3] = -1.0;  // max alpha3
+  weights[alpha3] = -1.0;  // max alpha3 (the start box's edge; inside the final box an interior optimum)
   bounding.SetParameterObjective(weights);
   LiftedLp shortw = BuildLiftedLp(lifted, box, {0, std::min(window, samples)}, LiftedForm::kFeasibility);
   shortw.SetSlackObjective();

@@ -1,6 +1,7 @@
 // `hwbounds bounds`: guaranteed parameter intervals of a Hammerstein–Wiener model from a recording.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -114,6 +115,15 @@ exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss:
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
   return options;
+}
+
+ExactPlotIntervals PlotIntervalsOf(const exact::ExactBoundsSummary& s) {
+  ExactPlotIntervals p;
+  for (const auto& iv : s.intervals) {
+    p.outer.emplace_back(iv.lower.value, iv.upper.value);
+    p.inner.push_back(iv.inner.value_or(std::pair<double, double>{NAN, NAN}));
+  }
+  return p;
 }
 
 dss::HwData ReadData(const BoundsCliOptions& o) {
@@ -361,6 +371,7 @@ void AddBoundsCommand(CLI::App& app) {
     nlohmann::json result = ResultJson(summary, *o, set, truth, covered);
     result["set"] = "dss";
     bool exact_invalidated = false;
+    std::optional<ExactPlotIntervals> exact_plot;
     if (o->set == "exact" && !invalidated) {
       std::fflush(stdout);
       ProgressDisplay exact_display(ChooseProgressMode(stderr, o->quiet, o->verbose), stderr);
@@ -384,10 +395,11 @@ void AddBoundsCommand(CLI::App& app) {
       fmt::print("{}", exact::ExactReport(exact_summary, exact_report));
       result = exact::ExactResultJson(exact_summary, result, summary, truth);
       exact_invalidated = exact_summary.invalidated;
+      if (!exact_invalidated) exact_plot = PlotIntervalsOf(exact_summary);
     }
     OutputFiles outputs;  // all or none, each renamed into place whole
     if (!o->json_out.empty()) outputs.Add(o->json_out, result.dump(2) + "\n");
-    if (!o->plot_out.empty()) outputs.Add(o->plot_out, RenderBoundsPlot(summary, truth, plot_terminal));
+    if (!o->plot_out.empty()) outputs.Add(o->plot_out, RenderBoundsPlot(summary, truth, plot_terminal, exact_plot ? &*exact_plot : nullptr));
     outputs.Commit();
     for (const auto& [path, bytes] : outputs.files()) fmt::print("wrote {}\n", path);
     if (invalidated || exact_invalidated) throw CommandExit{kExitInvalidated};

@@ -28,7 +28,8 @@ void AddCompareCommand(CLI::App& app) {
   cmd->add_option("--scenario", o->scenario,
                   "built-in scenario (setmembership-example, brouri-backlash, valve) or scenario JSON file")
       ->required();
-  cmd->add_option("--methods", o->methods, "comma list of setmembership, brouri, esmaeilani (default: all)")
+  cmd->add_option("--methods", o->methods, "comma list of setmembership, exact (the exact set D after D^ss(n)), brouri, esmaeilani (default: "
+                  "setmembership, brouri, esmaeilani)")
       ->delimiter(',');
   cmd->add_option("--runs", o->runs, "Monte Carlo runs R (run r uses seed S + r)");
   cmd->add_option("--seed", o->seed, "study seed S (also the seed of the common validation record)");

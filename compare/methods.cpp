@@ -4,12 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <random>
 
 #include <fmt/format.h>
 
 #include "core/input_error.hpp"
 #include "dss/set_membership.hpp"
+#include "exact/exact_bounds.hpp"
+#include "exact/two_stage.hpp"
 #include "estimators/brouri/workflow.hpp"
 #include "estimators/esmaeilani/estimator.hpp"
 #include "estimators/esmaeilani/valve_case.hpp"
@@ -111,11 +114,9 @@ Plant PlantFromTheta(const SetMembershipClass& cls, const std::vector<double>& t
   return p;
 }
 
-json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Record& rec, double bound,
-                      const Record& val) {
-  json out = {{"applicable", true}};
+// The prior box of the set-membership experiment (checked to hold the truth: the bounds assume it does).
+std::vector<std::pair<double, double>> PriorBox(const Scenario& s, const SetMembershipClass& cls) {
   const auto& sm = s.setmembership;
-  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
   auto box = sm.box;
   if (box.empty()) box.assign(cls.names.size(), {-sm.box_half_width, sm.box_half_width});
   if (box.size() != cls.names.size())
@@ -126,53 +127,123 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
       throw InputError(fmt::format("setmembership.box: the true {} = {} lies outside the prior box [{}, {}]; the "
                                    "bounds assume the box contains the truth", cls.names[k], cls.theta[k],
                                    box[k].first, box[k].second));
-  dss::HwOuterSet set(cls.structure, data, sm.horizon, box);
+  return box;
+}
+
+// The D^ss(n) run of the set-membership experiment, in this process (runs are already spread over workers).
+dss::BoundsSummary ComputeOuterSet(const Scenario& s, const dss::HwOuterSet& set) {
+  const auto& sm = s.setmembership;
   dss::BoundsOptions o;
   o.order = sm.order;
   o.solver = sm.solver;
   o.parameters = sm.parameters;
   o.contraction_passes = sm.contract_passes;
-  // Runs are already spread over worker processes; each run solves in its own process, sequentially.
   o.executor = std::make_shared<sdp::InProcessExecutor>();
   std::string err;
   if (!o.IsValid(&err)) throw InputError("setmembership options: " + err);
-  const auto summary = dss::ComputeBounds(o, set);
+  return dss::ComputeBounds(o, set);
+}
+
+// One interval as the comparison reports it.
+struct ReportedInterval {
+  std::string name;
+  double lower = 0.0, upper = 0.0;
+  std::string lower_status, upper_status;
+  std::optional<std::pair<double, double>> inner;
+};
+
+// Intervals, coverage of the truth, mean width and (when every parameter is bounded) the model at the interval
+// centres with its discrete quantities: the part of the report both set-membership methods share.
+void ReportIntervals(const Scenario& s, const SetMembershipClass& cls, const std::vector<ReportedInterval>& intervals,
+                     const std::vector<std::pair<double, double>>& box, bool all_guaranteed, double tolerance,
+                     const Record& val, json* out) {
+  json ivs = json::array();
+  int covered = 0;
+  double width_sum = 0.0;
+  std::vector<double> mid = cls.theta;  // filled for every computed parameter
+  for (const auto& iv : intervals) {
+    const std::size_t k = std::find(cls.names.begin(), cls.names.end(), iv.name) - cls.names.begin();
+    const double t = cls.theta[k];
+    const double tol = tolerance * (1.0 + std::abs(t));
+    const bool in = iv.lower - tol <= t && t <= iv.upper + tol;
+    covered += in;
+    width_sum += iv.upper - iv.lower;
+    mid[k] = 0.5 * (iv.lower + iv.upper);
+    json j = {{"name", iv.name}, {"lower", iv.lower}, {"upper", iv.upper}, {"lower_status", iv.lower_status},
+              {"upper_status", iv.upper_status}, {"width", iv.upper - iv.lower}, {"truth", t}, {"covered", in},
+              {"box", {box[k].first, box[k].second}}};
+    if (iv.inner) j["inner"] = {iv.inner->first, iv.inner->second};
+    ivs.push_back(j);
+  }
+  (*out)["intervals"] = ivs;
+  (*out)["coverage"] = {{"covered", covered}, {"total", intervals.size()}, {"all_guaranteed", all_guaranteed}};
+  (*out)["mean_width"] = intervals.empty() ? 0.0 : width_sum / intervals.size();
+  (*out)["status"] = "ok";
+  if (intervals.size() == cls.names.size()) {
+    // Point estimate: the centre of the interval box (each parameter's midpoint).
+    (*out)["point_estimate"] = {{"names", cls.names}, {"values", mid}, {"kind", "midpoints of the intervals"}};
+    DiscreteQuantities(s, s.plant, PlantFromTheta(cls, mid), val, out);
+  } else {
+    const std::string why = "only some intervals were computed (setmembership.parameters): no point estimate";
+    (*out)["not_available"] = {{"static_rms_pct", why}, {"static_max_pct", why}, {"freq_max_error", why},
+                               {"freq_rms_error", why}, {"fit_pct", why}};
+  }
+}
+
+json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Record& rec, double bound,
+                      const Record& val) {
+  json out = {{"applicable", true}};
+  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
+  const auto box = PriorBox(s, cls);
+  const dss::HwOuterSet set(cls.structure, data, s.setmembership.horizon, box);
+  const auto summary = ComputeOuterSet(s, set);
   out["noise_bound"] = bound;
   out["samples"] = rec.u.size();
   out["orthants"] = {{"total", summary.orthants_total}, {"empty", summary.orthants_empty},
                      {"solved", summary.orthants_solved}, {"failed", summary.orthants_failed}};
   out["sdp_solves"] = summary.sdp_solves;
-  json ivs = json::array();
-  int covered = 0;
-  double width_sum = 0.0;
-  std::vector<double> mid = cls.theta;  // filled for every computed parameter
+  std::vector<ReportedInterval> ivs;
+  for (const auto& iv : summary.intervals)
+    ivs.push_back({iv.name, iv.lower.value, iv.upper.value, dss::ToString(iv.lower.status),
+                   dss::ToString(iv.upper.status), {}});
+  ReportIntervals(s, cls, ivs, box, summary.all_guaranteed(), 1e-6 /* SDP solver accuracy */, val, &out);
+  return out;
+}
+
+// The exact set D on the same record: stage 1 is the D^ss(n) run above, stage 2 bounds D inside its box
+// (exact/exact_bounds.hpp), with an inner hull so every interval shows its tightness.
+json RunExactSet(const Scenario& s, const SetMembershipClass& cls, const Record& rec, double bound, const Record& val) {
+  json out = {{"applicable", true}};
+  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
+  const auto box = PriorBox(s, cls);
+  const dss::HwOuterSet set(cls.structure, data, s.setmembership.horizon, box);
+  const auto outer = ComputeOuterSet(s, set);
+  exact::ExactBoundsOptions o;
+  o.executor = std::make_shared<sdp::InProcessExecutor>();
+  o.parameters = s.setmembership.parameters;
+  const auto summary = exact::ComputeExactBounds(o, cls.structure, data, exact::StartBoxFromOuter(outer, set));
+  out["noise_bound"] = bound;
+  out["samples"] = rec.u.size();
+  out["assumption"] = summary.assumption.to_json();
+  out["invalidated"] = summary.invalidated;
+  out["stage2"] = summary.to_json().at("stage2");
+  if (summary.invalidated) {
+    out["status"] = "failed";
+    out["message"] = "the exact set is empty (certified): no model of the class explains the record";
+    return out;
+  }
+  std::vector<ReportedInterval> ivs;
+  bool all_guaranteed = true;
   for (const auto& iv : summary.intervals) {
-    const std::size_t k = std::find(cls.names.begin(), cls.names.end(), iv.name) - cls.names.begin();
-    const double t = cls.theta[k];
-    const double tol = 1e-6 * (1.0 + std::abs(t));  // SDP solver accuracy
-    const bool in = iv.lower.value - tol <= t && t <= iv.upper.value + tol;
-    covered += in;
-    width_sum += iv.upper.value - iv.lower.value;
-    mid[k] = 0.5 * (iv.lower.value + iv.upper.value);
-    ivs.push_back({{"name", iv.name}, {"lower", iv.lower.value}, {"upper", iv.upper.value},
-                   {"lower_status", iv.lower.status}, {"upper_status", iv.upper.status},
-                   {"width", iv.upper.value - iv.lower.value}, {"truth", t}, {"covered", in},
-                   {"box", {box[k].first, box[k].second}}});
+    if (!o.parameters.empty() &&
+        std::find(o.parameters.begin(), o.parameters.end(), iv.name) == o.parameters.end())
+      continue;
+    ivs.push_back({iv.name, iv.lower.value, iv.upper.value, exact::ToString(iv.lower.status),
+                   exact::ToString(iv.upper.status), iv.inner});
+    all_guaranteed = all_guaranteed && iv.lower.status != exact::EndpointStatus::kConservative &&
+                     iv.upper.status != exact::EndpointStatus::kConservative;
   }
-  out["intervals"] = ivs;
-  out["coverage"] = {{"covered", covered}, {"total", summary.intervals.size()},
-                     {"all_guaranteed", summary.all_guaranteed()}};
-  out["mean_width"] = summary.intervals.empty() ? 0.0 : width_sum / summary.intervals.size();
-  out["status"] = "ok";
-  if (summary.intervals.size() == cls.names.size()) {
-    // Point estimate: the centre of the interval box (each parameter's midpoint).
-    out["point_estimate"] = {{"names", cls.names}, {"values", mid}, {"kind", "midpoints of the intervals"}};
-    DiscreteQuantities(s, s.plant, PlantFromTheta(cls, mid), val, &out);
-  } else {
-    const std::string why = "only some intervals were computed (setmembership.parameters): no point estimate";
-    out["not_available"] = {{"static_rms_pct", why}, {"static_max_pct", why}, {"freq_max_error", why},
-                            {"freq_rms_error", why}, {"fit_pct", why}};
-  }
+  ReportIntervals(s, cls, ivs, box, all_guaranteed, 0.0 /* certified bounds: no tolerance */, val, &out);
   return out;
 }
 
@@ -463,6 +534,8 @@ nlohmann::json RunOne(const Scenario& s, const std::vector<std::string>& methods
     try {
       if (method == "setmembership") {
         m = RunSetMembership(s, SetMembershipTruth(s.plant), smrec, bound, val);
+      } else if (method == "exact") {
+        m = RunExactSet(s, SetMembershipTruth(s.plant), smrec, bound, val);
       } else if (method == "esmaeilani") {
         std::vector<Record> recs;
         for (int k = 0; k < s.esmaeilani.segments; ++k) {

@@ -131,6 +131,7 @@ namespace {
 // Legend entry of a method's curves; the set-membership one says what its curve is.
 std::string CurveTitle(const std::string& method) {
   if (method == "setmembership") return "setmembership: model at the interval centres, every run (flat = wide intervals)";
+  if (method == "exact") return "exact: model at the centres of the exact-set intervals, every run";
   return method + " (every run)";
 }
 }  // namespace

@@ -355,12 +355,19 @@ std::string OutputNotInvertible(const Scenario& s) {
 }  // namespace
 
 const std::vector<std::string>& AllMethods() {
-  static const std::vector<std::string> m = {"setmembership", "brouri", "esmaeilani"};
+  static const std::vector<std::string> m = {"setmembership", "exact", "brouri", "esmaeilani"};
   return m;
 }
 
 Applicability MethodApplies(const Scenario& s, const std::string& method) {
   Applicability a;
+  if (method == "exact") {  // the exact set D: the same model class and record, after the D^ss(n) run
+    a = MethodApplies(s, "setmembership");
+    if (a.applies)
+      a.experiment += "; the exact set D bounded inside the D^ss(n) box (assumes the inverse output map increases "
+                      "on the data range)";
+    return a;
+  }
   if (method == "setmembership") {
     if (s.kind == PlantKind::kBacklash) {
       a.reason = "the plant has a backlash (a memory operator, not a static map) and a non-invertible output "

@@ -60,10 +60,11 @@ bool StudyOptions::IsValid(std::string* error) const {
   if (runs < 1) return fail("--runs must be >= 1");
   if (jobs < 0) return fail("--jobs must be >= 0");
   if (out_dir.empty()) return fail("--out DIR is required");
-  if (methods.empty()) return fail("--methods needs at least one of setmembership, brouri, esmaeilani");
+  const std::string known = fmt::format("{}", fmt::join(AllMethods(), ", "));
+  if (methods.empty()) return fail("--methods needs at least one of " + known);
   for (const auto& m : methods)
     if (std::find(AllMethods().begin(), AllMethods().end(), m) == AllMethods().end())
-      return fail(fmt::format("--methods: '{}' unknown; expected setmembership, brouri, esmaeilani", m));
+      return fail(fmt::format("--methods: '{}' unknown; expected {}", m, known));
   return true;
 }
 

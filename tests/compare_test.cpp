@@ -230,5 +230,55 @@ TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth
   EXPECT_EQ(r2.summary["methods"].dump(), summary["methods"].dump());
 }
 
+
+TEST(CompareStudy, TheExactSetIsAMethodInsideTheOuterSetAndAroundTheTruth) {
+  auto s = LoadScenario("setmembership-example");
+  s.setmembership.samples = 40;
+  s.setmembership.horizon = 1;
+  s.setmembership.order = 1;
+  s.validation.samples = 200;
+  StudyOptions o;
+  o.runs = 2;
+  o.seed = 21;
+  o.jobs = 2;
+  o.quiet = true;
+  o.methods = {"setmembership", "exact"};
+  o.out_dir = ::testing::TempDir() + "/compare_exact";
+  fs::remove_all(o.out_dir);
+  const auto r = RunStudy(o, s);
+  EXPECT_TRUE(r.coverage_ok);
+  const auto truth = CeroneExample::TrueParameters();
+  for (int k = 0; k < o.runs; ++k) {
+    const json run = ReadJson(fmt::format("{}/runs/run_{:04d}.json", o.out_dir, k));
+    const auto& outer = run["methods"]["setmembership"];
+    const auto& ex = run["methods"]["exact"];
+    ASSERT_EQ(ex["status"], "ok") << ex.dump(1);
+    // The assumption is stated (whether the final box alone proves it depends on how wide alpha stays).
+    EXPECT_NE(ex["assumption"]["assumption"].get<std::string>().find("increases"), std::string::npos);
+    ASSERT_EQ(ex["intervals"].size(), truth.size());
+    double exact_width = 0.0, outer_width = 0.0;
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+      const auto& iv = ex["intervals"][p];
+      EXPECT_LE(iv["lower"].get<double>(), truth[p]) << iv.dump();
+      EXPECT_GE(iv["upper"].get<double>(), truth[p]) << iv.dump();
+      // Stage 2 starts in stage 1's box: never wider.
+      EXPECT_GE(iv["lower"].get<double>(), outer["intervals"][p]["lower"].get<double>()) << iv.dump();
+      EXPECT_LE(iv["upper"].get<double>(), outer["intervals"][p]["upper"].get<double>()) << iv.dump();
+      ASSERT_TRUE(iv.contains("inner")) << iv.dump();
+      EXPECT_LE(iv["lower"].get<double>(), iv["inner"][0].get<double>()) << iv.dump();
+      EXPECT_GE(iv["upper"].get<double>(), iv["inner"][1].get<double>()) << iv.dump();
+      exact_width += iv["width"].get<double>();
+      outer_width += outer["intervals"][p]["width"].get<double>();
+    }
+    EXPECT_LT(exact_width, outer_width) << "the exact set is smaller than D^ss(n)";
+  }
+  const json summary = ReadJson(o.out_dir + "/summary.json");
+  EXPECT_EQ(summary["methods"]["exact"]["coverage"]["covered"].get<int>(), o.runs * static_cast<int>(truth.size()));
+  std::ifstream md_in(o.out_dir + "/summary.md");
+  std::stringstream md;
+  md << md_in.rdbuf();
+  EXPECT_NE(md.str().find("Guaranteed intervals (exact)"), std::string::npos) << md.str();
+}
+
 }  // namespace
 }  // namespace hw::compare

@@ -270,6 +270,8 @@ TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
       break;
   }
   const std::string csv = ::testing::TempDir() + "exact_cli.csv", json = ::testing::TempDir() + "exact_cli.json";
+  const std::string png = ::testing::TempDir() + "exact_cli.png";
+  std::remove(png.c_str());
   {
     std::ofstream out(csv);
     out << "u,y,dy\n";
@@ -281,8 +283,8 @@ TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
   for (double v : inst.theta) truth += (truth.empty() ? "" : ",") + fmt::format("{:.17g}", v);
   const auto run = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --na 1 --nb 1 --input-basis poly:1 "
                                       "--output-basis poly:2 --horizon 1 --set exact --lp-budget 4 --sweeps 1 "
-                                      "--threads 1 --quiet --truth {} --json {}",
-                                      csv, truth, json));
+                                      "--threads 1 --quiet --truth {} --json {} --plot {}",
+                                      csv, truth, json, png));
   ASSERT_EQ(run.code, 0) << inst.description << "\n" << run.output;
   EXPECT_NE(run.output.find("exact set D"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("increases on the data range"), std::string::npos) << run.output;
@@ -294,6 +296,12 @@ TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
   EXPECT_TRUE(j.at("assumption").at("holds").get<bool>());
   EXPECT_GT(j.at("stage2").at("lps").get<int>(), 0);
   EXPECT_EQ(j.at("stage2").at("lp_solver"), "clp");
+  {  // the picture holds both sets
+    std::ifstream picture(png, std::ios::binary);
+    std::string magic(8, '\0');
+    picture.read(magic.data(), 8);
+    EXPECT_EQ(magic.substr(1, 3), "PNG");
+  }
   for (const auto& iv : j.at("intervals")) {
     EXPECT_EQ(iv.at("lower").at("verification"), "verified");
     EXPECT_TRUE(iv.contains("inner")) << iv.dump();
