@@ -45,8 +45,8 @@ void Run(const Opts& p, bool t_named, bool valid_t_named) {
   } else {
     spec = std::make_unique<diagnose::NominalSpec>(diagnose::NominalSpec::Parse(p.fit));
   }
-  const auto ident = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.data, ic));
-  const auto valid = diagnose::ReadRecording(diagnose::RecordingSpec::Parse(p.validate, vc));
+  const auto ident = diagnose::ReadRecording(diagnose::RecordingSource::Parse(p.data, ic));
+  const auto valid = diagnose::ReadRecording(diagnose::RecordingSource::Parse(p.validate, vc));
   if (spec) {
     const diagnose::NominalFit fit = diagnose::FitNominalForDiagnosis(*spec, ident, o);
     fmt::print("{}\n", fit.Summary());

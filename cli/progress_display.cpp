@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -13,6 +14,12 @@ constexpr const char* kRewriteLine = "\r\033[K";  // back to the line's start, e
 
 bool PhaseEnds(const dss::BoundsProgress& p) { return p.done >= p.total; }
 
+std::string SoFarText(const dss::BoundsProgress& p) {
+  if (p.so_far_parameter.empty()) return "";
+  const auto side = [](const std::optional<double>& v) { return v ? fmt::format("{:.6g}", *v) : std::string("?"); };
+  return fmt::format(", {} in [{}, {}] so far", p.so_far_parameter, side(p.so_far_lower), side(p.so_far_upper));
+}
+
 }  // namespace
 
 ProgressMode ChooseProgressMode(std::FILE* out, bool quiet, bool verbose) {
@@ -22,9 +29,9 @@ ProgressMode ChooseProgressMode(std::FILE* out, bool quiet, bool verbose) {
 }
 
 std::string ProgressLine(const dss::BoundsProgress& p) {
-  return fmt::format("[{}] {}/{} jobs{}, elapsed {:.0f} s, ETA {:.0f} s", p.phase, p.done, p.total,
+  return fmt::format("[{}] {}/{} jobs{}, elapsed {:.0f} s, ETA {:.0f} s{}", p.phase, p.done, p.total,
                      p.from_cache > 0 ? fmt::format(" (+{} from the run directory)", p.from_cache) : std::string(),
-                     p.elapsed_seconds, p.eta_seconds);
+                     p.elapsed_seconds, p.eta_seconds, SoFarText(p));
 }
 
 ProgressDisplay::ProgressDisplay(ProgressMode mode, std::FILE* out, double first_line_seconds,

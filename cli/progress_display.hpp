@@ -46,7 +46,9 @@ class ProgressDisplay {
   std::string live_phase_;  // the phase whose line is open (kLive); empty: none
 };
 
-// "[phase] 3/20 jobs (+2 from the run directory), elapsed 12 s, ETA 68 s".
+// "[phase] 3/20 jobs (+2 from the run directory), elapsed 12 s, ETA 68 s, a1 in [0.816, 1.667] so far" (the last part
+// when a relaxation job of the phase has bounded a parameter: its interval over the phase's finished jobs; "?" for a
+// side not bounded yet).
 std::string ProgressLine(const dss::BoundsProgress& p);
 
 }  // namespace hw::cli

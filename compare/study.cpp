@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -13,6 +13,7 @@
 #include "compare/methods.hpp"
 #include "core/atomic_write.hpp"
 #include "core/input_error.hpp"
+#include "core/json_input.hpp"
 #include "sdp/job_executor.hpp"
 
 namespace hw::compare {
@@ -29,15 +30,11 @@ std::string StudyKey(const Scenario& s, const StudyOptions& o) {
   return fmt::format("{:016x}", std::hash<std::string>{}(text));
 }
 
-bool ReadJsonFile(const std::string& path, json* j) {
-  std::ifstream in(path);
-  if (!in) return false;
-  try {
-    *j = json::parse(in);
-  } catch (const json::exception&) {
-    return false;
-  }
-  return true;
+// A run's result file when it is there, readable and of this study (a study resumes from those).
+std::optional<json> ReadRunOfStudy(const std::string& dir, int r, const std::string& key) {
+  auto j = ReadStoredJson(RunPath(dir, r));
+  if (!j || j->value("study_key", "") != key) return std::nullopt;
+  return j;
 }
 
 // Lower is better for errors, higher for the fit.
@@ -182,8 +179,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   StudySummary result;
   std::vector<int> pending;
   for (int r = 0; r < options.runs; ++r) {
-    json j;
-    if (ReadJsonFile(RunPath(options.out_dir, r), &j) && j.value("study_key", "") == key) ++result.runs_resumed;
+    if (ReadRunOfStudy(options.out_dir, r, key)) ++result.runs_resumed;
     else pending.push_back(r);
   }
   int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -223,8 +219,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   std::vector<json> runs;
   std::vector<int> missing;
   for (int r = 0; r < options.runs; ++r) {
-    json j;
-    if (ReadJsonFile(RunPath(options.out_dir, r), &j) && j.value("study_key", "") == key) runs.push_back(j);
+    if (auto j = ReadRunOfStudy(options.out_dir, r, key)) runs.push_back(std::move(*j));
     else missing.push_back(r);
   }
   if (!missing.empty())

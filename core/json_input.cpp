@@ -1,5 +1,7 @@
 #include "core/json_input.hpp"
 
+#include <fstream>
+
 #include <fmt/format.h>
 
 #include "core/csv_table.hpp"
@@ -29,6 +31,16 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& source,
 
 nlohmann::json ReadJsonFile(const std::string& path, const std::string& what) {
   return ParseJsonText(read_text_file(path, what), path, what);
+}
+
+std::optional<nlohmann::json> ReadStoredJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  try {
+    return nlohmann::json::parse(in);
+  } catch (...) {
+    return std::nullopt;
+  }
 }
 
 }  // namespace hw

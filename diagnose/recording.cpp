@@ -51,8 +51,8 @@ std::string HeaderList(const std::vector<std::string>& header) {
 
 }  // namespace
 
-RecordingSpec RecordingSpec::Parse(const std::string& text, const ColumnNames& defaults) {
-  RecordingSpec s;
+RecordingSource RecordingSource::Parse(const std::string& text, const ColumnNames& defaults) {
+  RecordingSource s;
   s.columns = defaults;
   s.path = text;
   if (text.empty()) throw InputError("recording '': no file name; expected FILE or FILE:u=NAME,y=NAME[,t=NAME]");
@@ -158,7 +158,7 @@ bool IsMatPath(const std::string& path) {
 
 // A MATLAB file through the project's reader (core/recording.hpp): the variables named by the spec
 // become u, y (and t when named, or when the file has a variable t).
-Recording ReadMatRecording(const RecordingSpec& spec, std::size_t min_samples) {
+Recording ReadMatRecording(const RecordingSource& spec, std::size_t min_samples) {
   const ColumnNames& c = spec.columns;
   std::string map;  // only the columns whose variable is not named like the column itself
   for (const auto& [column, variable] : {std::pair<std::string, std::string>{"u", c.u}, {"y", c.y}, {"t", c.t}})
@@ -172,7 +172,7 @@ Recording ReadMatRecording(const RecordingSpec& spec, std::size_t min_samples) {
 
 }  // namespace
 
-Recording ReadRecording(const RecordingSpec& spec, std::size_t min_samples) {
+Recording ReadRecording(const RecordingSource& spec, std::size_t min_samples) {
   if (IsMatPath(spec.path)) return ReadMatRecording(spec, min_samples);
   std::ifstream in(spec.path);
   if (!in) throw InputError(fmt::format("{}: cannot open file", spec.path));

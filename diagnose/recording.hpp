@@ -19,17 +19,20 @@ struct ColumnNames {
   bool t_required = false;  // true when the user named the time column explicitly
 };
 
-struct RecordingSpec {
+// A recording file and which of its columns are u, y and t (the defaults, overridden per file). Not a second
+// recording spec: the generic FILE.mat/.csv:COLUMN=VARIABLE map is core/recording.hpp's RecordingSpec, which a
+// .mat file's source is read through.
+struct RecordingSource {
   std::string path;
   ColumnNames columns;
   // "FILE" or "FILE:u=NAME,y=NAME[,t=NAME]"; the names given override `defaults`. Throws InputError.
-  static RecordingSpec Parse(const std::string& text, const ColumnNames& defaults);
+  static RecordingSource Parse(const std::string& text, const ColumnNames& defaults);
 };
 
 // Throws InputError naming the file, the line and the column on bad input: a used column missing or
 // named twice, a non-numeric or non-finite cell in a used column, a time column that does not increase,
 // or fewer than `min_samples` rows. Without a time column the sample index is used.
-Recording ReadRecording(const RecordingSpec& spec, std::size_t min_samples = 60);
+Recording ReadRecording(const RecordingSource& spec, std::size_t min_samples = 60);
 Recording ParseRecording(const std::string& text, const std::string& source, const ColumnNames& columns,
                          std::size_t min_samples = 60);
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "dss/cheap_pass.hpp"
+#include "dss/pipeline_state.hpp"
 
 namespace hw::dss {
 

@@ -64,6 +64,11 @@ struct BoundsProgress {
   int done = 0, total = 0;  // of the jobs still to run in this phase (jobs read from the run cache excluded)
   int from_cache = 0;       // jobs of this phase read from the run cache so far
   double elapsed_seconds = 0.0, eta_seconds = 0.0;
+  // The parameter whose relaxation job finished last in this phase, with its interval over the phase's finished
+  // jobs so far: each side the most extreme bound they gave (the finished interval is at least as wide; a side no
+  // job has bounded yet is absent). Empty name: no bound yet in this phase.
+  std::string so_far_parameter;
+  std::optional<double> so_far_lower, so_far_upper;
 };
 
 struct BoundsSummary {

@@ -9,7 +9,7 @@ namespace hw::dss {
 
 double ContractOrthantBoxes(EngineContext& ctx, const std::vector<Objective>& objectives, const PassOutcomes& pass,
                             std::vector<OrthantWork>& orthants, int order) {
-  const bool verify_on = ctx.options.generation.verify.enabled;
+  const bool verify_on = ctx.settings.verify();
   const int n = ctx.set.num_vars();
   double shrink = 0.0;
   for (auto& o : orthants) {
@@ -76,14 +76,11 @@ std::set<int> ContractAndReduceRows(EngineContext& ctx, const std::vector<Object
   return moved_index;
 }
 
-PassOutcomes ContractBeforeFullPass(EngineContext& ctx, const std::vector<Objective>& objectives,
-                                    const PassOutcomes& cheap, std::vector<OrthantWork>& orthants, int cheap_order) {
+void ContractBeforeFullPass(EngineContext& ctx, PipelineState& state, int cheap_order) {
   std::set<int> live;
-  for (const auto& w : orthants)
+  for (const auto& w : state.orthants)
     if (!w.empty()) live.insert(w.index);
-  PassOutcomes renumbered = cheap;
-  ContractAndReduceRows(ctx, objectives, renumbered, live, orthants, cheap_order);
-  return renumbered;
+  ContractAndReduceRows(ctx, state.objectives, state.cheap, live, state.orthants, cheap_order);
 }
 
 }  // namespace hw::dss

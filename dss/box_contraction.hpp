@@ -7,7 +7,6 @@
 #include <set>
 #include <vector>
 
-#include "dss/bound_jobs.hpp"
 #include "dss/cheap_pass.hpp"
 
 namespace hw::dss {
@@ -25,10 +24,9 @@ std::set<int> ContractAndReduceRows(EngineContext& ctx, const std::vector<Object
                                     PassOutcomes& outcomes, const std::set<int>& subset,
                                     std::vector<OrthantWork>& orthants, int order);
 
-// Before the order-delta pass: contracts the boxes to the cheap pass's bounds, reduces every contracted orthant's
-// rows again in its new box, and returns the cheap outcomes with their working sets renumbered to the new rows
+// Before the order-delta pass: contracts the boxes to the cheap pass's bounds (state.cheap), reduces every
+// contracted orthant's rows again in its new box, and renumbers the working sets in state.cheap to the new rows
 // (the full pass starts from them). Orthants whose box did not move keep their rows.
-PassOutcomes ContractBeforeFullPass(EngineContext& ctx, const std::vector<Objective>& objectives,
-                                    const PassOutcomes& cheap, std::vector<OrthantWork>& orthants, int cheap_order);
+void ContractBeforeFullPass(EngineContext& ctx, PipelineState& state, int cheap_order);
 
 }  // namespace hw::dss

@@ -9,7 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "core/input_error.hpp"
-#include "dss/set_membership.hpp"
+#include "dss/bounds_options.hpp"  // ValidAutoSplitRounds, with the other settings' checks
 
 namespace hw::dss {
 namespace {
@@ -312,10 +312,9 @@ std::vector<BoxCut> WithCut(std::vector<BoxCut> cuts, const std::string& paramet
   return cuts;
 }
 
-BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterSet& set,
-                                    const std::vector<BoxCut>& cuts,
-                                    const std::function<void(const BoundsProgress&)>& progress) {
-  if (cuts.empty()) return ComputeBounds(options, set, progress);
+BoundsSummary BoundsInPieces(const BoundsRun& run, const HwOuterSet& set, const std::vector<BoxCut>& cuts,
+                             const ProgressSink& progress) {
+  if (cuts.empty()) return run(set, progress);
   std::string error;
   if (!ValidBoxCuts(cuts, set.layout().names, set.box(), &error)) throw InputError(error);
   const auto t0 = std::chrono::steady_clock::now();
@@ -328,7 +327,7 @@ BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterS
       q.phase = fmt::format("piece {} of {}: {}", k + 1, boxes.size(), p.phase);
       progress(q);
     };
-    pieces.push_back(ComputeBounds(options, set.WithBox(boxes[k]), piece_progress));
+    pieces.push_back(run(set.WithBox(boxes[k]), piece_progress));
   }
   // An MPI worker rank served one session per piece, as the coordinator ran them, and holds no result.
   if (pieces.front().worker_rank) return pieces.front();
@@ -377,14 +376,13 @@ NextRound PlanNextRound(const BoundsSummary& result, const ParameterBox& box, co
 
 }  // namespace
 
-BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwOuterSet& set,
-                                         const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
-                                         const std::function<void(const BoundsProgress&)>& progress) {
+BoundsSummary BoundsWithAutoSplit(const BoundsRun& run, const std::string& executor, const HwOuterSet& set,
+                                  const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
+                                  const ProgressSink& progress) {
   std::string error;
   if (!auto_split.IsValid(&error)) throw InputError(error);
-  if (!ValidAutoSplitRounds(auto_split.rounds, options.executor ? options.executor->name() : "", &error))
-    throw InputError(error);
-  if (auto_split.rounds == 0) return ComputeBoundsInPieces(options, set, cuts, progress);
+  if (!ValidAutoSplitRounds(auto_split.rounds, executor, &error)) throw InputError(error);
+  if (auto_split.rounds == 0) return BoundsInPieces(run, set, cuts, progress);
   auto round_progress = [&](int round) {
     return [&progress, round](const BoundsProgress& p) {
       if (!progress) return;
@@ -395,7 +393,7 @@ BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwO
   };
   ParameterBox box = set.box();
   std::vector<BoxCut> round_cuts = cuts;
-  BoundsSummary result = ComputeBoundsInPieces(options, set, round_cuts, round_progress(0));
+  BoundsSummary result = BoundsInPieces(run, set, round_cuts, round_progress(0));
   nlohmann::json rounds = nlohmann::json::array({RoundJson(0, box, std::nullopt, 0.0, result)});
   std::string stopped = fmt::format("the {} round(s) asked for ran", auto_split.rounds);
   std::vector<BoundsSummary> earlier;
@@ -405,7 +403,7 @@ BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwO
       stopped = plan.stop;
       break;
     }
-    BoundsSummary next = ComputeBoundsInPieces(options, set.WithBox(plan.box), plan.cuts, round_progress(round));
+    BoundsSummary next = BoundsInPieces(run, set.WithBox(plan.box), plan.cuts, round_progress(round));
     KeepWitnesses(result, next);
     rounds.push_back(RoundJson(round, plan.box, plan.part, plan.cut, next));
     earlier.push_back(std::move(result));

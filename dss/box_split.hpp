@@ -13,7 +13,6 @@
 #include <utility>
 #include <vector>
 
-#include "dss/bounds_options.hpp"
 #include "dss/bounds_summary.hpp"
 #include "dss/hw_outer_set.hpp"
 
@@ -78,20 +77,25 @@ double CutBeyondWitness(const UnwitnessedPart& part, const BoundsSummary& summar
 std::vector<BoxCut> WithCut(std::vector<BoxCut> cuts, const std::string& parameter, double value,
                             const ParameterBox& box, const std::vector<std::string>& names);
 
-// ComputeBounds in each piece of set.box() (same options, run cache and executor; each piece resumes on its
-// own), combined by CombinePieces. Progress phases start with "piece k of K: ". No cut: ComputeBounds itself.
-BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterSet& set,
-                                    const std::vector<BoxCut>& cuts,
-                                    const std::function<void(const BoundsProgress&)>& progress = {});
+// One run of the bound engine over `set` (ComputeBounds with the caller's options, dss/set_membership.hpp): the
+// runs below call it once per piece, so that this file needs nothing of the engine but its results.
+using ProgressSink = std::function<void(const BoundsProgress&)>;
+using BoundsRun = std::function<BoundsSummary(const HwOuterSet& set, const ProgressSink& progress)>;
 
-// ComputeBoundsInPieces, then AutoSplitOptions::rounds rounds, each a run over the pieces of ProvenBox(last result)
-// cut at the previous cuts and at CutBeyondWitness(LargestUnwitnessedPart); the rounds stop early when no part
-// reaches min_fraction or its cut is already there. Each round bounds D^ss(n) in set.box(), so its intervals are
-// valid and lie inside the previous round's. The result is the last round's, with set.box() as its box, every
-// round's feasible points and witnessed ranges, counts and times summed over the rounds, and each round's box, cut
-// and intervals in `auto_split`. Not under an MPI executor (its worker ranks cannot follow the coordinator's cuts).
-BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwOuterSet& set,
-                                         const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
-                                         const std::function<void(const BoundsProgress&)>& progress = {});
+// `run` in each piece of set.box() (same options, run cache and executor; each piece resumes on its own), combined
+// by CombinePieces. Progress phases start with "piece k of K: ". No cut: `run` over set itself.
+BoundsSummary BoundsInPieces(const BoundsRun& run, const HwOuterSet& set, const std::vector<BoxCut>& cuts,
+                             const ProgressSink& progress);
+
+// BoundsInPieces, then AutoSplitOptions::rounds rounds, each a run over the pieces of ProvenBox(last result) cut at
+// the previous cuts and at CutBeyondWitness(LargestUnwitnessedPart); the rounds stop early when no part reaches
+// min_fraction or its cut is already there. Each round bounds D^ss(n) in set.box(), so its intervals are valid and
+// lie inside the previous round's. The result is the last round's, with set.box() as its box, every round's
+// feasible points and witnessed ranges, counts and times summed over the rounds, and each round's box, cut and
+// intervals in `auto_split`. Not under an MPI executor (`executor` names the run's; its worker ranks cannot follow
+// the coordinator's cuts).
+BoundsSummary BoundsWithAutoSplit(const BoundsRun& run, const std::string& executor, const HwOuterSet& set,
+                                  const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
+                                  const ProgressSink& progress);
 
 }  // namespace hw::dss

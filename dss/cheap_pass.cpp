@@ -82,21 +82,21 @@ double StopBeyond(const std::map<int, double>& witnessed, int j) {
   return it == witnessed.end() ? NAN : it->second;
 }
 
-CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
-                             const std::vector<Objective>& objectives, const PassOutcomes& settled,
-                             const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants) {
+CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx, PipelineState& state) {
   CheapPassResult result;
+  const std::vector<Objective>& objectives = state.objectives;
+  std::vector<OrthantWork>& orthants = state.orthants;
   std::map<int, std::vector<int>> seed_rows;  // data rows active in the previous pass, per orthant
   for (int pass = 0;; ++pass) {
     const bool contracting = pass < options.contraction_passes;
     const std::string phase = contracting ? fmt::format("order {} box contraction {}", options.order, pass + 1)
                                           : fmt::format("order {} relaxations", options.order);
-    const int max_rounds = contracting ? std::min(options.contraction_max_rounds, ctx.options.generation.max_rounds) : 0;
+    const int max_rounds = contracting ? std::min(options.contraction_max_rounds, ctx.settings.generation.max_rounds) : 0;
     // A contraction pass wants every bound as tight as its capped rounds allow, so it runs without stops.
-    result.outcomes = RunOnePass(ctx, objectives, settled, contracting ? std::map<int, double>{} : witnessed, orthants,
+    state.cheap = RunOnePass(ctx, objectives, state.settled, contracting ? std::map<int, double>{} : state.witnessed, orthants,
                                  options.order, max_rounds, phase, seed_rows);
     if (!contracting) break;
-    for (const auto& [key, r] : result.outcomes) {
+    for (const auto& [key, r] : state.cheap) {
       const OrthantWork* o = nullptr;
       for (const auto& w : orthants)
         if (w.index == key.first) o = &w;
@@ -108,7 +108,7 @@ CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx
       std::sort(rows.begin(), rows.end());
       rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
     }
-    const double shrink = ContractOrthantBoxes(ctx, objectives, result.outcomes, orthants, options.order);
+    const double shrink = ContractOrthantBoxes(ctx, objectives, state.cheap, orthants, options.order);
     result.contraction_passes_run = pass + 1;
     ReduceOrthantRows(ctx, orthants);  // the rows in the new boxes
     // Little movement: skip the remaining contraction passes and run the last (full) cheap pass.

@@ -8,12 +8,10 @@
 #include <map>
 #include <vector>
 
-#include "dss/bound_jobs.hpp"
+#include "dss/pipeline_state.hpp"
+#include "dss/relax_job.hpp"
 
 namespace hw::dss {
-
-// (orthant index, objective index) -> outcome.
-using PassOutcomes = std::map<std::pair<int, int>, JobOutcome>;
 
 struct CheapPassOptions {
   int order = 2;
@@ -23,16 +21,13 @@ struct CheapPassOptions {
 };
 
 struct CheapPassResult {
-  PassOutcomes outcomes;  // of the last (uncapped) pass
   int contraction_passes_run = 0;
 };
 
-// `settled`: objectives already decided per orthant (dss/edge_witness.hpp); they are not solved and their
-// outcomes are returned as given. `witnessed`: per objective index, a value attained by a certified feasible
-// point (EdgeWitnessResult::witnessed); a job may end once its bound is beyond it.
-CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx,
-                             const std::vector<Objective>& objectives, const PassOutcomes& settled,
-                             const std::map<int, double>& witnessed, std::vector<OrthantWork>& orthants);
+// Sets state.cheap to the outcomes of the last (uncapped) pass. The objectives in state.settled (dss/edge_witness.hpp)
+// are not solved: their outcomes are taken as given. state.witnessed: per objective index, a value attained by a
+// certified feasible point; a job may end once its bound is beyond it.
+CheapPassResult RunCheapPass(const CheapPassOptions& options, EngineContext& ctx, PipelineState& state);
 
 // The value a job of objective j may stop beyond (NaN: none).
 double StopBeyond(const std::map<int, double>& witnessed, int j);

@@ -136,7 +136,7 @@ nlohmann::json AnswerWitnessJob(const JobContext& job, const nlohmann::json& spe
   nlohmann::json answer{{"found", false}, {"solves", 0}};
   for (const auto& start : spec.at("starts")) {
     const auto w = LocalExtreme(job.prior_set(), l, param, dir, start.get<std::vector<double>>(),
-                                job.options().edge_witness.local, &rows);
+                                job.settings().local_search, &rows);
     answer["solves"] = answer["solves"].get<int>() + 1;
     if (w.found) {
       answer["found"] = true;
@@ -197,10 +197,10 @@ std::optional<JobOutcome> SettleBySignBeyondWitness(const HwOuterSet& set, const
                             witnessed));
 }
 
-EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
-                                         const std::vector<Objective>& objectives,
-                                         const std::vector<OrthantWork>& orthants) {
+EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx, PipelineState& state) {
   EdgeWitnessResult result;
+  const std::vector<Objective>& objectives = state.objectives;
+  const std::vector<OrthantWork>& orthants = state.orthants;
   if (!options.enabled || objectives.empty()) return result;
   const auto t0 = std::chrono::steady_clock::now();
   const HwOuterSet& set = ctx.set;
@@ -271,7 +271,7 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
 
   const std::vector<FeasiblePoint> certified = CertifiedFeasiblePoints(set, orthants, found);
   result.feasible_points = ExtremeFeasiblePoints(objectives, certified);
-  if (options.stop_beyond_witnesses) result.witnessed = WitnessedExtremes(objectives, certified);
+  if (options.stop_beyond_witnesses) state.witnessed = WitnessedExtremes(objectives, certified);
   // Certification here, whatever the workers said: the point must attain the edge and satisfy every row.
   std::map<int, int> edge_reached_in;  // objective -> orthant whose point attains the prior box edge
   for (const auto& [key, point] : found) {
@@ -291,7 +291,7 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
     if (!(slack >= 0)) continue;
     std::string text;
     for (std::size_t i = 0; i < p.size(); ++i) text += fmt::format("{}{} = {:.9g}", i ? ", " : "", set.layout().names[i], p[i]);
-    result.settled[key] = AtEdge(JobStatus::kSolved, edge, JobOrigin::kFeasiblePointAtEdge,
+    state.settled[key] = AtEdge(JobStatus::kSolved, edge, JobOrigin::kFeasiblePointAtEdge,
                                  fmt::format("a feasible point attains the prior box edge (certified min slack "
                                              "{:.3g}): {}", slack, text));
     result.points[key] = p;
@@ -301,7 +301,7 @@ EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, Engi
   for (const auto& [j, l] : edge_reached_in)
     for (const auto* w : live)
       if (w->index != l)
-        result.settled[{w->index, j}] =
+        state.settled[{w->index, j}] =
             AtEdge(JobStatus::kSkipped, EdgeOf(set.box(), objectives[j]), JobOrigin::kEdgeInOtherOrthant,
                    fmt::format("the interval already reaches the prior box edge (feasible point in orthant {})", l));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -14,23 +14,16 @@
 #include <utility>
 #include <vector>
 
-#include "dss/bound_jobs.hpp"
+#include "dss/job_context.hpp"
+#include "dss/job_dispatch.hpp"
+#include "dss/pipeline_state.hpp"
 #include "dss/edge_witness_options.hpp"
 
 namespace hw::dss {
 
-// Key (orthant, objective index) as in PassOutcomes.
-using ObjectiveKey = std::pair<int, int>;
-
+// What the stage found besides what it hands on in the pipeline state (SettleEdgesByWitnesses).
 struct EdgeWitnessResult {
-  // Settled objectives: in the orthant whose point attains the edge (solved, tight, origin kFeasiblePointAtEdge),
-  // and in the other live orthants (skipped: the interval already reaches the box edge).
-  std::map<ObjectiveKey, JobOutcome> settled;
   std::map<ObjectiveKey, std::vector<double>> points;  // the witness of each settling orthant (original units)
-  // Per objective index: the most extreme value of its parameter over every certified feasible point found (in
-  // any live orthant, inside its box). The endpoint is at least that extreme, so an orthant whose valid bound
-  // is already beyond it cannot move the endpoint (pop/constraint_generation.hpp, stop_beyond).
-  std::map<int, double> witnessed;
   // The certified feasible points most extreme in some objective's parameter (one per point, in objective
   // order): inner witnesses a user can check, and the inner side of each interval.
   std::vector<FeasiblePoint> feasible_points;
@@ -75,8 +68,12 @@ std::vector<nlohmann::json> RunWitnessJobs(EngineContext& ctx, const std::vector
 inline constexpr char kWitnessJob[] = "witness";
 nlohmann::json AnswerWitnessJob(const JobContext& job, const nlohmann::json& spec);
 
-EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx,
-                                         const std::vector<Objective>& objectives,
-                                         const std::vector<OrthantWork>& orthants);
+// The stage: fills state.settled with the objectives settled here, in the orthant whose point attains the edge
+// (solved, tight, origin kFeasiblePointAtEdge) and in the other live orthants (skipped: the interval already
+// reaches the box edge); and, with stop_beyond_witnesses, state.witnessed: per objective index the most extreme
+// value of its parameter over every certified feasible point found (in any live orthant, inside its box). The
+// endpoint is at least that extreme, so an orthant whose valid bound is already beyond it cannot move the
+// endpoint (pop/constraint_generation.hpp, stop_beyond).
+EdgeWitnessResult SettleEdgesByWitnesses(const EdgeWitnessOptions& options, EngineContext& ctx, PipelineState& state);
 
 }  // namespace hw::dss

@@ -15,7 +15,7 @@ struct EdgeWitnessOptions {
   // A witness attains the edge when |p_k - edge| <= edge_tolerance * box width (it is then moved onto it).
   double edge_tolerance = 1e-8;
   // Relaxation jobs end once their bound passes the value a certified feasible point attains (in any orthant):
-  // such a bound cannot move the endpoint (EdgeWitnessResult::witnessed). Off: every job runs to convergence.
+  // such a bound cannot move the endpoint (PipelineState::witnessed). Off: every job runs to convergence.
   bool stop_beyond_witnesses = true;
   InnerPointOptions local;
   bool IsValid(std::string* error) const;

@@ -7,10 +7,13 @@
 
 namespace hw::dss {
 
-PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, const std::vector<Objective>& objectives,
-                         const std::vector<int>& wanted_objectives, const PassOutcomes& cheap,
-                         const PassOutcomes& settled, const std::map<int, double>& witnessed,
-                         std::vector<OrthantWork>& orthants) {
+void RunFullPass(const FullPassOptions& options, EngineContext& ctx, PipelineState& state) {
+  const std::vector<Objective>& objectives = state.objectives;
+  const std::vector<int>& wanted_objectives = state.wanted_objectives;
+  const PassOutcomes& cheap = state.cheap;
+  const PassOutcomes& settled = state.settled;
+  const std::map<int, double>& witnessed = state.witnessed;
+  std::vector<OrthantWork>& orthants = state.orthants;
   PassOutcomes full;
   std::vector<double> current(objectives.size(), NAN);  // aggregated endpoint of the finished full-order jobs
   std::map<int, std::set<int>> active_rows;              // per orthant: data rows active at full order so far
@@ -79,7 +82,7 @@ PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, con
         if (c.status == JobStatus::kSolved) c.status = JobStatus::kSkipped;
         full[{w.index, o}] = c;
       }
-  return full;
+  state.full = std::move(full);
 }
 
 }  // namespace hw::dss

@@ -16,13 +16,10 @@ struct FullPassOptions {
   int cheap_order = 2;
 };
 
-// Outcomes at full order for the wanted objectives; orthants skipped keep their cheap outcome with status
-// "skipped" (its bound is valid and cannot move the interval). `settled` outcomes (dss/edge_witness.hpp) are
-// exact at every order and are returned as given; `witnessed` values (see RunCheapPass) let jobs end early and
-// skip orthants whose cheap bound is already beyond them.
-PassOutcomes RunFullPass(const FullPassOptions& options, EngineContext& ctx, const std::vector<Objective>& objectives,
-                         const std::vector<int>& wanted_objectives, const PassOutcomes& cheap,
-                         const PassOutcomes& settled, const std::map<int, double>& witnessed,
-                         std::vector<OrthantWork>& orthants);
+// Sets state.full to the outcomes at full order for the wanted objectives, from state.cheap; orthants skipped
+// keep their cheap outcome with status "skipped" (its bound is valid and cannot move the interval). state.settled
+// outcomes (dss/edge_witness.hpp) are exact at every order and are kept as given; state.witnessed values (see
+// RunCheapPass) let jobs end early and skip orthants whose cheap bound is already beyond them.
+void RunFullPass(const FullPassOptions& options, EngineContext& ctx, PipelineState& state);
 
 }  // namespace hw::dss

@@ -7,6 +7,7 @@
 
 #include "dss/edge_witness.hpp"
 #include "dss/orthant_screen.hpp"
+#include "dss/relax_job.hpp"
 #include "dss/row_reduction.hpp"
 
 namespace hw::dss {
@@ -22,8 +23,8 @@ const std::map<std::string, JobHandler>& Handlers() {
 
 }  // namespace
 
-sdp::JobFunction MakeJobFunction(const BoundsOptions& options, const HwOuterSet& set) {
-  auto job = std::make_shared<JobContext>(options, set);
+sdp::JobFunction MakeJobFunction(const EngineSettings& settings, const HwOuterSet& set) {
+  auto job = std::make_shared<JobContext>(settings, set);
   return [job](const std::string& text) -> std::string {
     const auto spec = nlohmann::json::parse(text);
     const std::string kind = spec.at("kind");

@@ -20,10 +20,12 @@ std::vector<double> ClippedToBox(std::vector<double> p, const ParameterBox& box)
 }  // namespace
 
 MomentWitnessResult FeasiblePointsFromMoments(const MomentWitnessOptions& options, EngineContext& ctx,
-                                              const std::vector<Objective>& objectives,
-                                              const std::vector<int>& wanted, const PassOutcomes& outcomes,
-                                              const std::vector<OrthantWork>& orthants) {
+                                              const PipelineState& state) {
   MomentWitnessResult result;
+  const std::vector<Objective>& objectives = state.objectives;
+  const std::vector<int>& wanted = state.wanted_objectives;
+  const PassOutcomes& outcomes = state.full;
+  const std::vector<OrthantWork>& orthants = state.orthants;
   if (!options.enabled) return result;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::pair<std::string, std::string>> jobs;

@@ -10,7 +10,7 @@
 // interval the relaxation may still overestimate. The bounds themselves do not change.
 #include <vector>
 
-#include "dss/cheap_pass.hpp"
+#include "dss/pipeline_state.hpp"
 #include "dss/inner_points.hpp"
 
 namespace hw::dss {
@@ -27,11 +27,9 @@ struct MomentWitnessResult {
   double seconds = 0.0;
 };
 
-// One witness job per wanted objective and live orthant whose outcome in `outcomes` is "solved" with first
+// One witness job per wanted objective and live orthant whose outcome in state.full is "solved" with first
 // moments, started from them (clipped to the orthant's box).
 MomentWitnessResult FeasiblePointsFromMoments(const MomentWitnessOptions& options, EngineContext& ctx,
-                                              const std::vector<Objective>& objectives,
-                                              const std::vector<int>& wanted, const PassOutcomes& outcomes,
-                                              const std::vector<OrthantWork>& orthants);
+                                              const PipelineState& state);
 
 }  // namespace hw::dss

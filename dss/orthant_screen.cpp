@@ -3,17 +3,18 @@
 #include <fmt/format.h>
 
 #include "pop/moment_lp.hpp"
+#include "sdp/sdp_solver.hpp"
 
 namespace hw::dss {
 
 nlohmann::json AnswerScreenJob(const JobContext& job, const nlohmann::json& spec) {
   const int l = spec.at("l");
   const HwOuterSet& set = job.prior_set();
-  const auto& gen_options = job.options().generation;
+  const auto& gen_options = job.settings().generation;
   std::vector<Polynomial> cons = set.sign_constraints(l);
   for (const auto& d : job.rows_in(set.box(), l)) cons.push_back(d.g);
   // An LP: DSDP's LP cone is not used for the screen (its certificates are checked on CSDP's and SDPA's form).
-  const std::string backend = SolverForOrder(job.options().solver, 1);
+  const std::string& backend = job.settings().backend(1);
   auto solver = sdp::MakeSolver(backend == "dsdp" ? "csdp" : backend);
   sdp::SdpOptions lp_options = gen_options.sdp;
   lp_options.keep_dual_matrix = false;

@@ -7,7 +7,8 @@
 #include <optional>
 #include <vector>
 
-#include "dss/bound_jobs.hpp"
+#include "dss/job_context.hpp"
+#include "dss/job_dispatch.hpp"
 
 namespace hw::dss {
 

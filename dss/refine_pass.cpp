@@ -59,19 +59,20 @@ std::vector<std::pair<int, int>> OpenEndpoints(const std::vector<Objective>& obj
   });
 }
 
-RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx,
-                                 const std::vector<Objective>& objectives, const std::vector<int>& wanted,
-                                 const PassOutcomes& full, const std::map<int, double>& witnessed,
-                                 std::vector<OrthantWork>& orthants) {
+RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx, PipelineState& state) {
   RefinePassResult result;
-  result.outcomes = full;
+  const std::vector<Objective>& objectives = state.objectives;
+  const std::vector<int>& wanted = state.wanted_objectives;
+  const std::map<int, double>& witnessed = state.witnessed;
+  std::vector<OrthantWork>& orthants = state.orthants;
+  PassOutcomes& outcomes = state.full;
   std::map<int, std::size_t> position;  // orthant index -> position in `orthants`
   for (std::size_t i = 0; i < orthants.size(); ++i) position[orthants[i].index] = i;
-  const bool verify_on = ctx.options.generation.verify.enabled;
+  const bool verify_on = ctx.settings.verify();
   for (int pass = 0; pass < options.passes; ++pass) {
     const auto targets = options.every_endpoint
-                             ? OpenEndpoints(objectives, wanted, result.outcomes, orthants, witnessed)
-                             : StoppedShortEndpoints(objectives, wanted, result.outcomes, orthants);
+                             ? OpenEndpoints(objectives, wanted, outcomes, orthants, witnessed)
+                             : StoppedShortEndpoints(objectives, wanted, outcomes, orthants);
     if (targets.empty()) break;
     ++result.passes_run;
     // The targets' orthants, contracted to this pass's verified bounds, with their rows reduced again; an
@@ -79,14 +80,14 @@ RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext
     std::set<int> target_orthants;
     for (const auto& [l, o] : targets) target_orthants.insert(l);
     const std::set<int> moved_index =
-        ContractAndReduceRows(ctx, objectives, result.outcomes, target_orthants, orthants, options.order);
+        ContractAndReduceRows(ctx, objectives, outcomes, target_orthants, orthants, options.order);
     if (moved_index.empty()) break;
     std::vector<RelaxJob> jobs;
     std::vector<std::pair<int, int>> job_key;
     for (const auto& [l, o] : targets) {
       const OrthantWork& w = orthants[position.at(l)];
       if (!moved_index.count(l)) continue;  // moved orthants are live
-      jobs.push_back({&w, objectives[o], options.order, result.outcomes.at({l, o}).working_set, 0,
+      jobs.push_back({&w, objectives[o], options.order, outcomes.at({l, o}).working_set, 0,
                       StopBeyond(witnessed, o)});
       job_key.push_back({l, o});
     }
@@ -97,7 +98,7 @@ RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext
     const auto outs = RunRelaxationJobs(ctx, jobs, orthants);
     result.jobs_run += static_cast<int>(jobs.size());
     for (std::size_t i = 0; i < jobs.size(); ++i) {
-      JobOutcome& kept = result.outcomes.at(job_key[i]);
+      JobOutcome& kept = outcomes.at(job_key[i]);
       const JobOutcome& again = outs[i];
       const int dir = objectives[job_key[i].second].dir;
       // Infeasible: the orthant is empty (RunRelaxationJobs recorded the certificate). Solved: both bounds hold,

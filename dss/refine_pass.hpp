@@ -22,7 +22,6 @@ struct RefinePassOptions {
 };
 
 struct RefinePassResult {
-  PassOutcomes outcomes;  // the full pass's outcomes with the refined ones in place
   int passes_run = 0;
   int jobs_run = 0;
   int bounds_tightened = 0;
@@ -40,9 +39,7 @@ std::vector<std::pair<int, int>> OpenEndpoints(const std::vector<Objective>& obj
                                                const PassOutcomes& full, const std::vector<OrthantWork>& orthants,
                                                const std::map<int, double>& witnessed);
 
-RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx,
-                                 const std::vector<Objective>& objectives, const std::vector<int>& wanted,
-                                 const PassOutcomes& full, const std::map<int, double>& witnessed,
-                                 std::vector<OrthantWork>& orthants);
+// Refines the wanted endpoints in state.full (the refined outcomes replace the full pass's in place).
+RefinePassResult RefineEndpoints(const RefinePassOptions& options, EngineContext& ctx, PipelineState& state);
 
 }  // namespace hw::dss

@@ -179,7 +179,7 @@ nlohmann::json AnswerReduceJob(const JobContext& job, const nlohmann::json& spec
   }
   std::vector<Polynomial> fixed = set.box_constraints();
   for (auto& g : set.sign_constraints(l)) fixed.push_back(std::move(g));
-  const auto r = ReduceDataRows(job.options().reduction, rows, steps, fixed);
+  const auto r = ReduceDataRows(job.settings().reduction, rows, steps, fixed);
   std::vector<int> kept;  // indices into all_rows
   for (int k : r.kept) kept.push_back(index[k]);
   nlohmann::json counts = nlohmann::json::array();
@@ -203,7 +203,7 @@ void ReduceOrthantRows(EngineContext& ctx, std::vector<OrthantWork>& orthants) {
     for (int s = 1; s <= ctx.set.horizon(); ++s) {
       std::string key = fmt::format("reduce_l{}_s{}", o.index, s);
       if (o.box != ctx.set.box()) key += "_b" + BoxHash(o.box);
-      if (!ctx.options.reduction.enabled) key += "_off";
+      if (!ctx.settings.reduction.enabled) key += "_off";
       jobs.push_back({nlohmann::json{{"kind", kReduceJob}, {"l", o.index}, {"box", o.box}, {"step", s}}.dump(), key});
       job_of.push_back({k, s});
     }

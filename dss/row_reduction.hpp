@@ -42,7 +42,8 @@ RowReductionResult ReduceDataRows(const RowReductionOptions& options, const std:
 
 }  // namespace hw::dss
 
-#include "dss/bound_jobs.hpp"
+#include "dss/job_context.hpp"
+#include "dss/job_dispatch.hpp"
 
 namespace hw::dss {
 

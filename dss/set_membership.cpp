@@ -8,18 +8,11 @@
 #include <fmt/ranges.h>
 
 #include "core/input_error.hpp"
-#include "dss/aggregate.hpp"
-#include "dss/bound_jobs.hpp"
 #include "dss/box_contraction.hpp"
-#include "dss/cheap_pass.hpp"
-#include "dss/edge_witness.hpp"
-#include "dss/full_pass.hpp"
+#include "dss/engine_setup.hpp"
 #include "dss/job_function.hpp"
-#include "dss/moment_witness.hpp"
-#include "dss/orthant_screen.hpp"
-#include "dss/refine_pass.hpp"
+#include "dss/pipeline_state.hpp"
 #include "dss/row_reduction.hpp"
-#include "sdp/sdp_solver.hpp"
 
 namespace hw::dss {
 namespace {
@@ -32,29 +25,6 @@ std::string sign_text(const HwOuterSet& set, int l) {
   for (std::size_t k = 0; k < signs.size(); ++k)
     s += fmt::format("{}{}{}", k ? " " : "", set.sign_names()[k], signs[k] > 0 ? "+" : "-");
   return s;
-}
-
-// The engine-wide SDP settings every job uses (see the comments), applied to a copy of the caller's options.
-BoundsOptions EngineOptions(const BoundsOptions& options) {
-  BoundsOptions opts = options;
-  // In scaled coordinates every feasible moment vector has |y_alpha| <= 1, so a multiplier X >= 0 with
-  // sum_i |F_i . X| < F_0 . X already proves emptiness; 0.5 leaves a margin.
-  opts.generation.sdp.infeasibility_tolerance = std::max(opts.generation.sdp.infeasibility_tolerance, 0.5);
-  // Endpoints come from the dual side, whose validity needs dual feasibility, not a small gap: accept
-  // near-optimal stops up to 1e-5 (the gap costs at most that much tightness on the scaled parameters).
-  opts.generation.sdp.acceptable_gap = std::max(opts.generation.sdp.acceptable_gap, 1e-5);
-  // The engine's own fallbacks (the other backend, then the verified bounds of the rounds) follow a failed
-  // round, so a second SDPA attempt with other parameters would only add a full solve to each failing round.
-  opts.generation.sdp.retry_with_default_parameters = false;
-  return opts;
-}
-
-// The backend of every relaxation order (index 0: order 1), whatever the run's order.
-std::vector<std::string> BackendsByOrder(const BoundsOptions& options) {
-  std::vector<std::string> backends;
-  for (int d = 1; d <= kMaxOrder; ++d)
-    backends.push_back(SolverForOrder(options.solver, d, options.generation.block_order_cap));
-  return backends;
 }
 
 // "order d", or the mixed relaxation's name when the cap lowers some data row's localizing order d - ceil(deg / 2).
@@ -72,9 +42,10 @@ std::string RelaxationName(const HwOuterSet& set, int order, int block_order_cap
 // depend on it, so runs of several orders share one directory and an order-3 run reads back the order-2 jobs
 // of an order-2 run (its cheap pass). Nor contract_before_full_pass: a job in a contracted box has the box's hash
 // in its name.
-std::string ProblemKey(const BoundsOptions& options, const HwOuterSet& set, nlohmann::json* meta) {
+std::string ProblemKey(const BoundsOptions& options, const EngineSettings& settings, const HwOuterSet& set,
+                       nlohmann::json* meta) {
   *meta = {{"parameters", set.layout().names}, {"horizon", set.horizon()},
-           {"cheap_pass", options.cheap_pass}, {"solver", options.solver}, {"backends", BackendsByOrder(options)},
+           {"cheap_pass", options.cheap_pass}, {"solver", options.solver}, {"backends", settings.backends},
            {"box", set.box()},
            {"violation_tolerance", options.generation.violation_tolerance},
            {"gap_tolerance", options.generation.sdp.gap_tolerance}, {"verify", options.generation.verify.enabled},
@@ -129,8 +100,10 @@ void AttachWitnessedRanges(const HwOuterSet& set, const std::vector<FeasiblePoin
 }
 
 // Each orthant's status and certificate (screen, then the pipeline's passes), its row reduction and contracted box.
-void ReportOrthants(const HwOuterSet& set, const ScreenResult& screen, const std::vector<OrthantWork>& orthants,
-                    const PassOutcomes& full, const std::vector<int>& wanted_objectives, BoundsSummary& summary) {
+void ReportOrthants(const HwOuterSet& set, const ScreenResult& screen, const PipelineState& state,
+                    BoundsSummary& summary) {
+  const std::vector<OrthantWork>& orthants = state.orthants;
+  const PassOutcomes& full = state.full;
   summary.orthants_total = set.num_orthants();
   std::vector<std::optional<EmptinessCertificate>> certificate = screen.certificates;
   std::vector<OrthantStatus> status;
@@ -138,7 +111,7 @@ void ReportOrthants(const HwOuterSet& set, const ScreenResult& screen, const std
   for (const auto& w : orthants) {
     if (w.empty()) certificate[w.index] = w.certificate;
     bool failed = false;
-    for (int o : wanted_objectives)
+    for (int o : state.wanted_objectives)
       if (full.count({w.index, o}) && full.at({w.index, o}).status == JobStatus::kFailed) failed = true;
     status[w.index] = w.empty() ? OrthantStatus::kEmpty : failed ? OrthantStatus::kFailed : OrthantStatus::kSolved;
     summary.row_reduction.push_back({{"orthant", w.index}, {"per_step", w.reduction}});
@@ -170,34 +143,30 @@ void CopyJobCounters(EngineCounters counters, BoundsSummary& summary) {
 }  // namespace
 
 
-BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSet& set,
+BoundsSummary ComputeBounds(const BoundsOptions& options, const HwOuterSet& set,
                             const std::function<void(const BoundsProgress&)>& progress) {
   std::string error;
-  if (!caller_options.IsValid(&error)) throw InputError("bounds options: " + error);
-  const BoundsOptions options = EngineOptions(caller_options);
+  if (!options.IsValid(&error)) throw InputError("bounds options: " + error);
   const auto t0 = Clock::now();
-  // Minimal order from the constraint degrees: Remark 3, ceil((n + 1) / 2), and >= 1 for the box.
-  const int min_order = MinimalOrder(set.horizon());
   if (!ValidOrder(options.order, set.horizon(), &error)) throw InputError(error);
-  // Order 1 (Shor) returns the box edges for these problems, so the cheap order is at least 2; with nothing
-  // cheaper than the target order there is no separate cheap pass.
-  const int cheap_order = options.cheap_pass ? std::min(options.order, std::max(min_order, 2)) : options.order;
+  // The options, converted once into what the stages read.
+  const EngineSettings settings = ToEngineSettings(options);
+  const StageOptions stages = ToStageOptions(options, set.horizon());
+  PipelineState state;
   const std::vector<int> wanted = WantedParameters(options, set);
   // Objectives: min and max of every wanted parameter (of every parameter when boxes are contracted).
-  std::vector<Objective> objectives;
   for (int k = 0; k < set.num_vars(); ++k)
     if (options.contraction_passes > 0 || std::find(wanted.begin(), wanted.end(), k) != wanted.end()) {
-      objectives.push_back({k, -1});
-      objectives.push_back({k, +1});
+      state.objectives.push_back({k, -1});
+      state.objectives.push_back({k, +1});
     }
-  std::vector<int> wanted_objectives;
-  for (std::size_t o = 0; o < objectives.size(); ++o)
-    if (std::find(wanted.begin(), wanted.end(), objectives[o].param) != wanted.end())
-      wanted_objectives.push_back(static_cast<int>(o));
+  for (std::size_t o = 0; o < state.objectives.size(); ++o)
+    if (std::find(wanted.begin(), wanted.end(), state.objectives[o].param) != wanted.end())
+      state.wanted_objectives.push_back(static_cast<int>(o));
 
   const std::shared_ptr<sdp::JobExecutor> executor =
       options.executor ? options.executor : std::make_shared<sdp::ForkExecutor>(options.threads);
-  const sdp::JobFunction job = MakeJobFunction(options, set);
+  const sdp::JobFunction job = MakeJobFunction(settings, set);
   // Worker ranks (MPI) answer jobs until the coordinator ends the session; they report nothing themselves.
   if (!executor->is_coordinator()) {
     executor->Serve(job);
@@ -211,67 +180,48 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   } session_end{*executor};
 
   nlohmann::json meta;
-  const RunCache cache(options.run_dir, ProblemKey(options, set, &meta), meta);
+  const RunCache cache(options.run_dir, ProblemKey(options, settings, set, &meta), meta);
   EngineCounters counters;
   ProgressReporter reporter(progress);
   if (const auto line = cache.resume_line()) reporter.Message(*line);
-  EngineContext ctx{options, set, *executor, job, cache, counters, reporter};
+  EngineContext ctx{settings, set, *executor, job, cache, counters, reporter};
 
   // 1. Screen orthants.
-  const ScreenResult screen = ScreenOrthants(ScreenOptions{options.lp_screen}, ctx);
-  std::vector<OrthantWork> orthants;
+  const ScreenResult screen = ScreenOrthants(stages.screen, ctx);
   const int rows_per_orthant = set.num_orthants() > 0 ? static_cast<int>(set.data_constraints(0).size()) : 0;
   for (int l : screen.alive) {
     OrthantWork w;
     w.index = l;
     w.box = set.box();
     for (int r = 0; r < rows_per_orthant; ++r) w.rows.push_back(r);
-    orthants.push_back(std::move(w));
+    state.orthants.push_back(std::move(w));
   }
   // 2. Reduce rows.
-  ReduceOrthantRows(ctx, orthants);
+  ReduceOrthantRows(ctx, state.orthants);
   // 3. Endpoints at the box edge, settled by feasible points.
-  EdgeWitnessOptions edge_options = options.edge_witness;
-  edge_options.enabled = edge_options.enabled && options.order >= edge_options.min_order;
-  const EdgeWitnessResult edges = SettleEdgesByWitnesses(edge_options, ctx, objectives, orthants);
+  const EdgeWitnessResult edges = SettleEdgesByWitnesses(stages.edge_witness, ctx, state);
   // 4. Cheap pass (with box contraction when asked).
-  CheapPassOptions cheap_options{cheap_order, options.contraction_passes, options.contraction_min_shrink,
-                                 options.contraction_max_rounds};
-  const CheapPassResult cheap = RunCheapPass(cheap_options, ctx, objectives, edges.settled, edges.witnessed, orthants);
+  const CheapPassResult cheap = RunCheapPass(stages.cheap, ctx, state);
   // 5. Full pass, in boxes contracted to the cheap bounds.
-  PassOutcomes cheap_outcomes = cheap.outcomes;
-  if (options.order > cheap_order && options.contract_before_full_pass)
-    cheap_outcomes = ContractBeforeFullPass(ctx, objectives, cheap.outcomes, orthants, cheap_order);
-  PassOutcomes full = cheap_outcomes;
-  if (options.order > cheap_order)
-    full = RunFullPass(FullPassOptions{options.order, cheap_order}, ctx, objectives, wanted_objectives, cheap_outcomes,
-                       edges.settled, edges.witnessed, orthants);
+  if (stages.has_full_pass() && stages.contract_before_full_pass) ContractBeforeFullPass(ctx, state, stages.cheap.order);
+  state.full = state.cheap;
+  if (stages.has_full_pass()) RunFullPass(stages.full, ctx, state);
   // 6. Solve again, in contracted boxes, the endpoints that rest on a solve that stopped short.
-  const RefinePassResult refined =
-      RefineEndpoints(RefinePassOptions{options.order, options.stopped_short_refinements, false}, ctx, objectives,
-                      wanted_objectives, full, edges.witnessed, orthants);
-  full = refined.outcomes;
+  const RefinePassResult refined = RefineEndpoints(stages.stopped_short, ctx, state);
   // 6b. Solve every open endpoint again in the box of the full pass's own bounds (off by default).
-  const RefinePassResult endpoints_refined =
-      RefineEndpoints(RefinePassOptions{options.order, options.endpoint_refinements, true}, ctx, objectives,
-                      wanted_objectives, full, edges.witnessed, orthants);
-  full = endpoints_refined.outcomes;
-  // 7. Feasible points where the relaxations' moments point (the witnessed ranges; the bounds do not change). Not
-  // below the edge-witness stage's order: there the SDP jobs cost less than the local searches.
-  const MomentWitnessResult from_moments = FeasiblePointsFromMoments(
-      MomentWitnessOptions{options.moment_witnesses && options.order >= options.edge_witness.min_order, options.order},
-      ctx, objectives, wanted_objectives, full, orthants);
+  const RefinePassResult endpoints_refined = RefineEndpoints(stages.every_endpoint, ctx, state);
+  // 7. Feasible points where the relaxations' moments point (the witnessed ranges; the bounds do not change).
+  const MomentWitnessResult from_moments = FeasiblePointsFromMoments(stages.moment_witness, ctx, state);
   // 8. Aggregate.
-  const AggregateResult agg = AggregateIntervals(
-      AggregateOptions{options.generation.verify.enabled, options.order, cheap_order}, set, objectives, wanted,
-      cheap_outcomes, full, orthants);
+  const AggregateResult agg = AggregateIntervals(stages.aggregate, set, state.objectives, wanted, state.cheap,
+                                                 state.full, state.orthants);
 
   BoundsSummary summary;
   summary.intervals = agg.intervals;
   summary.bound_sources = agg.sources;
   std::vector<FeasiblePoint> feasible = edges.feasible_points;
   feasible.insert(feasible.end(), from_moments.feasible_points.begin(), from_moments.feasible_points.end());
-  summary.feasible_points = ExtremeFeasiblePoints(objectives, feasible);
+  summary.feasible_points = ExtremeFeasiblePoints(state.objectives, feasible);
   AttachWitnessedRanges(set, summary.feasible_points, summary.intervals);
   summary.clipped_to_box = agg.clipped_to_box;
   summary.contraction_passes_run = cheap.contraction_passes_run;
@@ -281,22 +231,43 @@ BoundsSummary ComputeBounds(const BoundsOptions& caller_options, const HwOuterSe
   summary.endpoint_refine_tightened = endpoints_refined.bounds_tightened;
   summary.order = options.order;
   summary.horizon = set.horizon();
-  summary.solver = SolverForOrder(options.solver, options.order, options.generation.block_order_cap);
+  summary.solver = settings.backend(options.order);
   summary.solver_option = options.solver;
   summary.relaxation = RelaxationName(set, options.order, options.generation.block_order_cap);
   summary.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
   summary.box = set.box();
   summary.parameter_names = set.layout().names;
-  ReportOrthants(set, screen, orthants, full, wanted_objectives, summary);
+  ReportOrthants(set, screen, state, summary);
   summary.edge_witness_solves = edges.local_solves;
   summary.edge_witness_seconds = edges.seconds;
   summary.moment_witness_jobs = from_moments.jobs;
   summary.moment_witness_found = static_cast<int>(from_moments.feasible_points.size());
   summary.moment_witness_seconds = from_moments.seconds;
-  for (const auto& [key, r] : edges.settled) summary.edge_witness_settled += r.status == JobStatus::kSolved ? 1 : 0;
+  for (const auto& [key, r] : state.settled) summary.edge_witness_settled += r.status == JobStatus::kSolved ? 1 : 0;
   CopyJobCounters(counters, summary);
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return summary;
+}
+
+namespace {
+
+BoundsRun RunWith(const BoundsOptions& options) {
+  return [&options](const HwOuterSet& set, const ProgressSink& progress) { return ComputeBounds(options, set, progress); };
+}
+
+}  // namespace
+
+BoundsSummary ComputeBoundsInPieces(const BoundsOptions& options, const HwOuterSet& set,
+                                    const std::vector<BoxCut>& cuts,
+                                    const std::function<void(const BoundsProgress&)>& progress) {
+  return BoundsInPieces(RunWith(options), set, cuts, progress);
+}
+
+BoundsSummary ComputeBoundsWithAutoSplit(const BoundsOptions& options, const HwOuterSet& set,
+                                         const std::vector<BoxCut>& cuts, const AutoSplitOptions& auto_split,
+                                         const std::function<void(const BoundsProgress&)>& progress) {
+  return BoundsWithAutoSplit(RunWith(options), options.executor ? options.executor->name() : "", set, cuts,
+                             auto_split, progress);
 }
 
 }  // namespace hw::dss

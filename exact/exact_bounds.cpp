@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.hpp"
-#include "dss/bound_jobs.hpp"
+#include "dss/run_cache.hpp"
 #include "exact/exact_jobs.hpp"
 
 namespace hw::exact {

@@ -14,7 +14,7 @@ namespace {
 // arrays are checked as the CLI checks a file's columns.
 diagnose::Recording RecordingArg(py::handle h, const std::string& what) {
   if (py::isinstance<py::str>(h))
-    return diagnose::ReadRecording(diagnose::RecordingSpec::Parse(h.cast<std::string>(), diagnose::ColumnNames{}));
+    return diagnose::ReadRecording(diagnose::RecordingSource::Parse(h.cast<std::string>(), diagnose::ColumnNames{}));
   const CsvTable t = RecordingFromPython(h, what, {"u", "y"}, {"t"});
   return diagnose::MakeRecording(what, t.has("t") ? t.column("t") : std::vector<double>{}, t.column("u"),
                                  t.column("y"));

@@ -169,10 +169,10 @@ TEST(Recordings, OnlyUsedColumnsAreReadAndNamesMayDifferPerFile) {
   EXPECT_EQ(r.u, (Vec{1, 5, 9}));
   EXPECT_EQ(r.y, (Vec{3, 7, 11}));
   EXPECT_EQ(r.t, (Vec{0, 1, 2}));
-  const RecordingSpec spec = RecordingSpec::Parse("bench.csv:u=uVal,y=yVal", ColumnNames{});
+  const RecordingSource spec = RecordingSource::Parse("bench.csv:u=uVal,y=yVal", ColumnNames{});
   EXPECT_EQ(spec.path, "bench.csv");
   EXPECT_EQ(ParseRecording(text, spec.path, spec.columns, 3).y, (Vec{4, 8, 12}));
-  EXPECT_THROW(RecordingSpec::Parse("bench.csv:w=uVal", ColumnNames{}), InputError);
+  EXPECT_THROW(RecordingSource::Parse("bench.csv:w=uVal", ColumnNames{}), InputError);
   try {
     ParseRecording("u,y\n1,2\n3,x\n", "bad.csv", ColumnNames{}, 1);
     FAIL();

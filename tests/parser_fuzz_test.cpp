@@ -385,8 +385,8 @@ void ParseCandidateList(const std::string& text) {
     if (!diagnose::IsDefined(e, l)) throw std::logic_error("an undefined block");
 }
 
-void ParseDiagnoseRecordingSpec(const std::string& text) {
-  const auto spec = diagnose::RecordingSpec::Parse(text, diagnose::ColumnNames{});
+void ParseDiagnoseRecordingSource(const std::string& text) {
+  const auto spec = diagnose::RecordingSource::Parse(text, diagnose::ColumnNames{});
   if (spec.path.empty()) throw std::logic_error("no path");
   for (const auto* name : {&spec.columns.u, &spec.columns.y, &spec.columns.t})
     if (name->empty() || name->find(',') != std::string::npos) throw std::logic_error("column name '" + *name + "'");
@@ -444,7 +444,7 @@ TEST(ParserFuzz, DiagnoseTexts) {
               return std::vector<std::string>{"rec.csv:z=a", "rec.csv:u=",      "rec.csv:u=a,,y=b",
                                               "rec.csv:u=a,u=b", ":u=a", "rec.csv:u=a,y"};
             },
-            ParseDiagnoseRecordingSpec},
+            ParseDiagnoseRecordingSource},
            kInputs);
 }
 

@@ -11,7 +11,7 @@
 #include "compare/methods.hpp"
 #include "compare/scenario.hpp"
 #include "dss/basis.hpp"
-#include "dss/bound_jobs.hpp"
+#include "dss/engine_setup.hpp"
 #include "dss/hw_outer_set.hpp"
 #include "dss/job_function.hpp"
 #include "dss/row_reduction.hpp"
@@ -200,7 +200,7 @@ TEST(RowReduction, OneJobPerHorizonStepKeepsTheRowsOfOneJobPerOrthant) {
   // job over every row keeps (and their counts per step match).
   const auto [set, truth] = RandomSet(4, 40, 3);
   const int l = set.orthant_of(truth);
-  const auto job = MakeJobFunction(BoundsOptions{}, set);
+  const auto job = MakeJobFunction(ToEngineSettings(BoundsOptions{}), set);
   auto reduce = [&](int step) {
     nlohmann::json spec{{"kind", "reduce"}, {"l", l}, {"box", set.box()}};
     if (step != 0) spec["step"] = step;

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/cerone_example.hpp"
-#include "dss/bound_jobs.hpp"
+#include "dss/relax_job.hpp"
 #include "dss/edge_witness.hpp"
 #include "dss/set_membership.hpp"
 #include "pop/constraint_generation.hpp"
