@@ -190,14 +190,17 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   f.validation = c.Compare(ref.valid_residual, v1, c.skip, c.nv, f.extra_parameters, c.o.validation_z);
   // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
   // the fitting part): a candidate that validation confirms may then pass the first test with the
-  // recordings' roles swapped instead (as strict as validation: refitted on the validation recording,
-  // scored on the whole identification recording against the reference refitted there).
+  // recordings' roles swapped instead (refitted on the validation recording, scored on the whole
+  // identification recording against the reference refitted there). Both recordings then judge models
+  // fitted on the other one, which also rewards a better optimum of a poorly determined nominal (a
+  // cubic input map under a two-level input): this path asks for a large penalised reduction on both.
   Comparison first = f.holdout;
-  if (!f.holdout.significant && f.validation.significant && !ref.swapped_residual.empty()) {
+  if (!f.holdout.significant && f.validation.significant && f.validation.score >= c.o.swapped_min_improvement &&
+      !ref.swapped_residual.empty()) {
     f.swapped = c.Compare(ref.swapped_residual, c.SwappedResidual(f.model), c.skip, c.n, f.extra_parameters,
                           c.o.validation_z);
     f.swapped_tested = true;
-    if (f.swapped.significant) first = f.swapped;
+    if (f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement) first = f.swapped;
   }
   const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
   f.score = 1.0 - std::sqrt(ph * pv);
@@ -432,6 +435,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!(holdout_fraction > 0.05 && holdout_fraction < 0.8)) return fail("holdout_fraction must be in (0.05, 0.8)");
   if (!(significance_z > 0) || !(validation_z >= 0)) return fail("significance_z > 0 and validation_z >= 0 required");
   if (!(min_improvement >= 0 && min_improvement < 1)) return fail("min_improvement must be in [0, 1)");
+  if (!(swapped_min_improvement >= 0 && swapped_min_improvement <= 1))
+    return fail("swapped_min_improvement must be in [0, 1] (1 = never swap the recordings' roles)");
   if (max_lag < 1) return fail("max_lag must be >= 1");
   if (pair_partners < 0) return fail("pair_partners must be >= 0");
   if (threads < 0) return fail("threads must be >= 0 (0 = hardware concurrency)");
@@ -564,7 +569,7 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
   }
   const double excess = mse_base - sigma * sigma;
   double explained = verdict ? (mse_base - Mse(c.IdentResidual(verdict->fitted), c.nfit, c.n)) / excess : 0.0;
-  if (verdict && verdict->swapped_tested && verdict->swapped.significant) {
+  if (verdict && verdict->swapped_tested && verdict->swapped.significant && verdict->swapped.score >= c.o.swapped_min_improvement) {
     // Confirmed with the roles swapped: the excess is the one of the reference refitted on validation.
     const double swapped_excess = verdict->swapped.mse_baseline - sigma * sigma;
     explained = std::max(explained, swapped_excess > 0 ? (verdict->swapped.mse_baseline - verdict->swapped.mse) / swapped_excess : 1.0);
