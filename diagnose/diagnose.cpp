@@ -148,10 +148,7 @@ struct Reference {
 // operating point.
 // A band must also sit inside the signal's central range (within a quarter of its 5-95 % spread of the
 // median): a "dead band" at the edge of the data is a clamp, and saturation is the block for that.
-// Stiction without a stick-slip jump (kinetic band within 2 % of the static band) is backlash with one
-// more parameter: the backlash block, always tried as well, names it.
 bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t skip) {
-  if (b.effect == Effect::kStiction) return b.params[0] - b.params[1] > 0.02 * b.params[0];
   if (b.effect != Effect::kDeadzone) return true;
   const Vec v(signal.begin() + std::min(skip, signal.size()), signal.end());
   Vec mag;
@@ -228,6 +225,7 @@ std::string Evidence(const Finding& f) {
                                      "reduction {:.1f} %, z = {:.1f})", f.swapped.ratio, 100 * f.swapped.score, f.swapped.z)
                        : std::string(),
       f.eligible ? "; eligible"
+                 : f.jumpless_stiction ? "; no stick-slip jump: backlash describes it"
                  : (!f.meaningful ? "; physically meaningless parameters"
                                   : (!f.beats_richer && f.validation.significant
                                          ? "; no better than a richer nominal"
@@ -327,8 +325,23 @@ Reference Baseline(const Context& c, const AugmentedModel& nominal, const Nomina
   ref.valid_residual = c.ValidationResidual(RefitModel(best, c.full, c.o.refit).model);
   if (c.o.richer_nominal && (structure || NominalSpec::Of(nominal.nominal, &spec)))
     Richer(c, structure ? *structure : spec, &ref, r);
-  ref.swapped_residual = c.SwappedResidual(RefitModel(ref.fitted, c.full, c.o.refit).model);
+  if (c.o.swapped_min_improvement < 1.0)
+    ref.swapped_residual = c.SwappedResidual(RefitModel(ref.fitted, c.full, c.o.refit).model);
   return ref;
+}
+
+// Stiction without a stick-slip jump (kinetic band within 2 % of the static band) is backlash with one
+// more parameter (up to a one-sample stick at fast reversals): when backlash is eligible, it names it.
+void PreferBacklashToJumplessStiction(std::vector<Finding>* fs) {
+  bool backlash = false;
+  for (const auto& f : *fs) backlash = backlash || (f.eligible && f.blocks.front().effect == Effect::kBacklash);
+  for (auto& f : *fs) {
+    const auto& p = f.blocks.front().params;
+    if (backlash && f.blocks.front().effect == Effect::kStiction && p[0] - p[1] <= 0.02 * p[0]) {
+      f.eligible = false;
+      f.jumpless_stiction = true;
+    }
+  }
 }
 
 std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
@@ -337,6 +350,7 @@ std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
   ParallelFor(candidates.size(), c.o.threads,
               [&](std::size_t i) { out[i] = EvaluateAddition(c, base, candidates[i].first, candidates[i].second); });
   out.erase(std::remove_if(out.begin(), out.end(), [](const Finding& f) { return f.blocks.empty(); }), out.end());
+  PreferBacklashToJumplessStiction(&out);
   for (auto& f : out) f.evidence = Evidence(f);
   RankFindings(&out);
   return out;
