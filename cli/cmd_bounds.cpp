@@ -96,6 +96,7 @@ struct BoundsCliOptions {
   std::string set = "dss";  // which feasible set the intervals bound: dss (D^ss(n)) or exact (D, after D^ss(n))
   int lp_budget = exact::ObjectiveSearchOptions{}.lp_budget;
   int sweeps = exact::ExactBoundsOptions{}.sweeps;
+  std::string lp_solver = exact::ExactBoundsOptions{}.lp_solver;
 };
 
 // What the bounds of the exact set D need besides the D^ss(n) run: its start box is that run's result.
@@ -109,6 +110,7 @@ exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss:
   options.parameters = o.params;
   options.search.lp_budget = o.lp_budget;
   options.sweeps = o.sweeps;
+  options.lp_solver = o.lp_solver;
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
   return options;
@@ -299,6 +301,8 @@ void AddBoundsCommand(CLI::App& app) {
       ->check(CLI::IsMember({"dss", "exact"}));
   cmd->add_option("--lp-budget", o->lp_budget, "--set exact: LPs per endpoint refinement (>= 1)");
   cmd->add_option("--sweeps", o->sweeps, "--set exact: bounding sweeps, each in the box the previous proved (1..5)");
+  cmd->add_option("--lp-solver", o->lp_solver, "--set exact: the LP backend, clp or glpk (certificates do not depend on it)")
+      ->check(CLI::IsMember(exact::AvailableLpSolvers()));
   cmd->add_option("--json", o->json_out, "write the result as JSON");
   cmd->add_option("--plot", o->plot_out,
                   "draw the intervals as a PNG (gnuplot): each in its prior box and stretched to its own width, with "

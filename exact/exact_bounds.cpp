@@ -258,7 +258,7 @@ nlohmann::json ExactBoundsSummary::to_json() const {
             {"jobs_from_cache", jobs_from_cache}, {"lp_rows", lp_rows}, {"lp_cols", lp_cols},
             {"lp_nonzeros", lp_nonzeros}, {"prune_seconds", prune_seconds}, {"inner_seconds", inner_seconds},
             {"bound_seconds", bound_seconds}, {"wall_seconds", wall_seconds}, {"inner_points", inner_points},
-            {"executor", executor}}}};
+            {"executor", executor}, {"lp_solver", lp_solver}}}};
 }
 
 ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
@@ -285,6 +285,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     ~SessionEnd() { e.EndSession(); }
   } session_end{*executor};
   s.executor = fmt::format("{} ({} workers)", executor->name(), executor->workers());
+  s.lp_solver = options.lp_solver;
   s.parameter_names = lay.names;
   s.start_box = start_box;
   {
@@ -293,7 +294,14 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     s.lp_cols = shape.lp.num_cols();
     s.lp_nonzeros = static_cast<long>(shape.lp.entries.size());
   }
-  nlohmann::json meta = {{"engine", "exact"}, {"start_box", BoxToJson(start_box)}};
+  // Everything a job's answer depends on besides its spec: a run directory never answers for other settings.
+  const auto& ev = options.evaluation;
+  nlohmann::json meta = {{"engine", "exact"},
+                         {"start_box", BoxToJson(start_box)},
+                         {"lp_solver", options.lp_solver},
+                         {"lp_budget", options.search.lp_budget},
+                         {"cheap_windows", {ev.cheap_window, ev.cheap_windows}},
+                         {"lp_tolerances", {ev.lp.primal_tolerance, ev.lp.dual_tolerance, ev.lp.time_limit_seconds}}};
   const std::string key = JobKey(meta.dump() + std::to_string(lifted.num_samples));
   const dss::RunCache cache(options.run_dir, "exact-" + key, meta);
   JobRunner runner(*executor, cache, fn, s);

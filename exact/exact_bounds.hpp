@@ -100,6 +100,7 @@ struct ExactBoundsSummary {
   int inner_points = 0;
   AssumptionCheck assumption;
   std::string executor;
+  std::string lp_solver;       // the LP backend that ran (certificates do not depend on it)
   bool worker_rank = false;
   nlohmann::json to_json() const;
 };

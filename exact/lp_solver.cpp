@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include "exact/clp_solver.hpp"
+#include "exact/glpk_solver.hpp"
 
 namespace hw::exact {
 
@@ -31,7 +32,7 @@ bool LpSolveOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::vector<std::string> AvailableLpSolvers() { return {"clp"}; }
+std::vector<std::string> AvailableLpSolvers() { return {"clp", "glpk"}; }
 
 bool ValidLpSolverName(const std::string& name, std::string* error) {
   const auto names = AvailableLpSolvers();
@@ -43,6 +44,7 @@ bool ValidLpSolverName(const std::string& name, std::string* error) {
 std::unique_ptr<LpSolver> MakeLpSolver(const std::string& name) {
   std::string error;
   if (!ValidLpSolverName(name, &error)) throw std::invalid_argument(error);
+  if (name == "glpk") return std::make_unique<GlpkSolver>();
   return std::make_unique<ClpSolver>();
 }
 

@@ -12,6 +12,7 @@
 #include "exact/branch_and_bound.hpp"
 #include "exact/clp_solver.hpp"
 #include "exact/exact_bounds.hpp"
+#include "exact/glpk_solver.hpp"
 #include "exact/membership.hpp"
 #include "exact/safe_bound.hpp"
 #include "random_hw.hpp"
@@ -85,6 +86,53 @@ TEST(LiftedLp, TheTruthsBoxIsNeverProvenEmptyAndABoxFarAwayIs) {
   const BoxEvaluation e = TestBoxEmpty(d, far, ev, clp);
   ASSERT_EQ(e.verdict, BoxVerdict::kPruned) << inst.description;
   EXPECT_GT(e.certificate->residual_lower_bound, 0.0);
+}
+
+TEST(LpBackends, ClpAndGlpkAgreeOnTheOptimumAndBothDualsCertify) {
+  const auto inst = InstanceOf(11, 80);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  const ParamBox box = BoxAround(d, inst.theta, 1e-2, 1.0);
+  LiftedLp lifted = BuildLiftedLp(d, box, WholeRecord(d), LiftedForm::kBounding);
+  std::vector<double> weights(d.layout.count(), 0.0);
+  weights[d.layout.b_begin] = 1.0;  // min b_first
+  lifted.SetParameterObjective(weights);
+  ClpSolver clp;
+  GlpkSolver glpk;
+  const LpResult rc = clp.Solve(lifted.lp, {}, {}), rg = glpk.Solve(lifted.lp, {}, {});
+  ASSERT_EQ(rc.status, LpStatus::kOptimal) << rc.message;
+  ASSERT_EQ(rg.status, LpStatus::kOptimal) << rg.message;
+  EXPECT_NEAR(rc.objective, rg.objective, 1e-6 * (1.0 + std::abs(rc.objective)));
+  for (const LpResult* r : {&rc, &rg}) {
+    const double safe = SafeLowerBound(lifted.lp, r->duals);
+    EXPECT_LE(safe, r->objective + 1e-9);
+    EXPECT_GT(safe, r->objective - 1e-6 * (1.0 + std::abs(r->objective)));
+    EXPECT_LE(safe, inst.theta[d.layout.b_begin]) << inst.description;  // the truth is in the box
+  }
+  // GLPK's own basis warm-starts it: the same problem again needs no pivot.
+  EXPECT_EQ(glpk.Solve(lifted.lp, rg.basis, {}).iterations, 0);
+  // Emptiness of a far box is certified from either backend's duals.
+  ParamBox far = box;
+  far[d.layout.a_begin].lo += 0.3, far[d.layout.a_begin].hi += 0.3;
+  BoxEvaluationOptions ev;
+  ev.cheap_window = 0;
+  EXPECT_EQ(TestBoxEmpty(d, far, ev, glpk).verdict, BoxVerdict::kPruned);
+  EXPECT_EQ(TestBoxEmpty(d, box, ev, glpk).verdict, BoxVerdict::kKept);
+}
+
+TEST(ExactBounds, TheGlpkBackendContainsTheTruthAsClpDoes) {
+  const auto inst = InstanceOf(5, 80);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  ExactBoundsOptions o = SmallRunOptions();
+  o.lp_solver = "glpk";
+  const auto s = ComputeExactBounds(o, inst.structure, inst.data, BoxAround(d, inst.theta, 0.05, 1.0));
+  for (int k = 0; k < d.layout.count(); ++k) {
+    EXPECT_LE(s.intervals[k].lower.value, inst.theta[k]) << d.layout.names[k];
+    EXPECT_GE(s.intervals[k].upper.value, inst.theta[k]) << d.layout.names[k];
+  }
+  std::string error;
+  o.lp_solver = "highs";
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("clp, glpk"), std::string::npos) << error;
 }
 
 // An LP backend that answers "optimal" with random duals and a made-up value, or "infeasible" without duals.
@@ -245,6 +293,7 @@ TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
   EXPECT_EQ(j.at("outer_set_intervals").size(), j.at("intervals").size());
   EXPECT_TRUE(j.at("assumption").at("holds").get<bool>());
   EXPECT_GT(j.at("stage2").at("lps").get<int>(), 0);
+  EXPECT_EQ(j.at("stage2").at("lp_solver"), "clp");
   for (const auto& iv : j.at("intervals")) {
     EXPECT_EQ(iv.at("lower").at("verification"), "verified");
     EXPECT_TRUE(iv.contains("inner")) << iv.dump();
@@ -260,6 +309,9 @@ TEST(ExactCli, BoundsSetExactWritesBothSetsTheAssumptionAndTheCounts) {
   EXPECT_EQ(zero.code, 2) << zero.output;
   EXPECT_NE(zero.output.find("--lp-budget 0"), std::string::npos) << zero.output;
   EXPECT_EQ(zero.output.find("orthants"), std::string::npos) << zero.output;
+  const auto highs = testing_support::RunCli(fmt::format("bounds --data {} --noise-col dy --set exact --lp-solver highs", csv));
+  EXPECT_EQ(highs.code, 2) << highs.output;
+  EXPECT_NE(highs.output.find("--lp-solver"), std::string::npos) << highs.output;
 }
 #endif
 
