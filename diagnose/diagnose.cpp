@@ -108,6 +108,13 @@ struct Context {
     return Residual(valid.y, m.simulate(valid.u));
   }
   Vec IdentResidual(const AugmentedModel& m) const { return Residual(ident.y, m.simulate(ident.u)); }
+  // The validation test with the recordings' roles swapped: the model refitted on the validation
+  // recording, its residual on the identification recording (initial state re-estimated there).
+  Vec SwappedResidual(const AugmentedModel& m) const {
+    AugmentedModel r = RefitModel(m, validation, o.refit).model;
+    EstimateInitialState(&r, full, o.refit);
+    return Residual(ident.y, r.simulate(ident.u));
+  }
   // Penalty factor for k extra parameters scored on ns samples: FPE on the fitting part, BIC-like on the scored part.
   double Penalty(int k, std::size_t ns) const {
     const double nf = static_cast<double>(nfit - skip), nsd = static_cast<double>(std::max<std::size_t>(ns, 2));
@@ -132,6 +139,7 @@ struct Reference {
   AugmentedModel fitted;  // on the fitting part
   Vec ident_residual;     // of `fitted` on the identification recording
   Vec valid_residual;     // of the reference refitted on the whole identification recording
+  Vec swapped_residual;   // of the reference refitted on the validation recording, on the identification one
   double richer_score = 0.0;  // penalised held-out score of the best richer nominal against `fitted`
 };
 
@@ -177,12 +185,26 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
   const Vec v1 = c.ValidationResidual(f.model);
   f.validation = c.Compare(ref.valid_residual, v1, c.skip, c.nv, f.extra_parameters, c.o.validation_z);
-  const double ph = std::max(1.0 - f.holdout.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
+  // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
+  // the fitting part): a candidate that validation confirms may then pass the first test with the
+  // recordings' roles swapped instead (refitted on the validation recording, scored on the whole
+  // identification recording against the reference refitted there). Both recordings then judge models
+  // fitted on the other one, which also rewards a better optimum of a poorly determined nominal (a
+  // cubic input map under a two-level input): this path asks for a large penalised reduction on both.
+  Comparison first = f.holdout;
+  if (!f.holdout.significant && f.validation.significant && f.validation.score >= c.o.swapped_min_improvement &&
+      !ref.swapped_residual.empty()) {
+    f.swapped = c.Compare(ref.swapped_residual, c.SwappedResidual(f.model), c.skip, c.n, f.extra_parameters,
+                          c.o.validation_z);
+    f.swapped_tested = true;
+    if (f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement) first = f.swapped;
+  }
+  const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
   f.score = 1.0 - std::sqrt(ph * pv);
-  // Robust to the nominal: the block must also do better on the held-out tail than a richer nominal.
-  f.beats_richer = f.holdout.score > ref.richer_score;
+  // Robust to the nominal: the block must also do better than a richer nominal on the held-out tail.
+  f.beats_richer = first.score >= ref.richer_score;
   f.meaningful = meaningful;
-  f.eligible = f.holdout.significant && f.validation.significant && f.beats_richer && meaningful;
+  f.eligible = first.significant && f.validation.significant && f.beats_richer && meaningful;
   return f;
 }
 
@@ -196,15 +218,31 @@ void RankFindings(std::vector<Finding>* fs) {
 std::string Evidence(const Finding& f) {
   return fmt::format(
       "held-out MSE {:.3g}x the baseline's (penalised reduction {:.1f} %, z = {:.1f}); validation MSE {:.3g}x "
-      "(penalised reduction {:.1f} %, z = {:.1f}){}; {}",
+      "(penalised reduction {:.1f} %, z = {:.1f}){}{}; {}",
       f.holdout.ratio, 100 * f.holdout.score, f.holdout.z, f.validation.ratio, 100 * f.validation.score,
       f.validation.z,
+      f.swapped_tested ? fmt::format("; roles swapped (refit on validation, scored on identification): MSE {:.3g}x (penalised "
+                                     "reduction {:.1f} %, z = {:.1f})", f.swapped.ratio, 100 * f.swapped.score, f.swapped.z)
+                       : std::string(),
       f.eligible ? "; eligible"
+                 : f.jumpless_stiction ? "; no stick-slip jump: backlash describes it"
                  : (!f.meaningful ? "; physically meaningless parameters"
-                                  : (!f.beats_richer && f.holdout.significant && f.validation.significant
+                                  : (!f.beats_richer && f.validation.significant
                                          ? "; no better than a richer nominal"
                                          : "; not significant on both")),
       ParamText(f.model));
+}
+
+// A richer numerator absorbs a dead time (its leading coefficients go to 0): before a richer nominal
+// replaces the baseline, the nominal with an integer input delay (one parameter, against the richer
+// structure's two or more) competes on the same penalised held-out score. When it does at least as
+// well, the baseline stays and the delay is judged with the other effects (it must still beat the
+// richer nominal's score there).
+bool DelayExplainsAsWell(const Context& c, const Reference& ref, double richer_score) {
+  const RefitResult fit = AddBlock(ref.fitted, Effect::kDelay, Location::kInput, c.o.state_variable, c.fit, c.o.refit);
+  if (fit.model.blocks.size() <= ref.fitted.blocks.size()) return false;
+  const int k = fit.extra_parameters - EffectParameterCount(ref.fitted);
+  return c.Compare(ref.ident_residual, c.IdentResidual(fit.model), c.nfit, c.n, k, c.o.significance_z).score >= richer_score;
 }
 
 // Richer nominal structures than `spec`: one more pole and numerator coefficient, and, for structures
@@ -238,7 +276,7 @@ void Richer(const Context& c, const NominalSpec& spec, Reference* ref, DiagnoseR
     const Comparison h = c.Compare(ref->ident_residual, e, c.nfit, c.n, k, c.o.significance_z);
     r->richer_note += fmt::format("{}{}: held-out MSE {:.3g}x the baseline's (penalised score {:.3f}, z = {:.1f})",
                                   r->richer_note.empty() ? "" : "; ", s.Text(), h.ratio, h.score, h.z);
-    if (h.significant) {
+    if (h.significant && !DelayExplainsAsWell(c, *ref, h.score)) {
       const Vec v = c.ValidationResidual(RefitModel(fit.model, c.full, c.o.refit).model);
       if (c.Compare(ref->valid_residual, v, c.skip, c.nv, k, c.o.validation_z).significant) {
         r->richer_note += " — better on validation too: it replaces the baseline";
@@ -287,7 +325,23 @@ Reference Baseline(const Context& c, const AugmentedModel& nominal, const Nomina
   ref.valid_residual = c.ValidationResidual(RefitModel(best, c.full, c.o.refit).model);
   if (c.o.richer_nominal && (structure || NominalSpec::Of(nominal.nominal, &spec)))
     Richer(c, structure ? *structure : spec, &ref, r);
+  if (c.o.swapped_min_improvement < 1.0)
+    ref.swapped_residual = c.SwappedResidual(RefitModel(ref.fitted, c.full, c.o.refit).model);
   return ref;
+}
+
+// Stiction without a stick-slip jump (kinetic band within 2 % of the static band) is backlash with one
+// more parameter (up to a one-sample stick at fast reversals): when backlash is eligible, it names it.
+void PreferBacklashToJumplessStiction(std::vector<Finding>* fs) {
+  bool backlash = false;
+  for (const auto& f : *fs) backlash = backlash || (f.eligible && f.blocks.front().effect == Effect::kBacklash);
+  for (auto& f : *fs) {
+    const auto& p = f.blocks.front().params;
+    if (backlash && f.blocks.front().effect == Effect::kStiction && p[0] - p[1] <= 0.02 * p[0]) {
+      f.eligible = false;
+      f.jumpless_stiction = true;
+    }
+  }
 }
 
 std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
@@ -296,6 +350,7 @@ std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
   ParallelFor(candidates.size(), c.o.threads,
               [&](std::size_t i) { out[i] = EvaluateAddition(c, base, candidates[i].first, candidates[i].second); });
   out.erase(std::remove_if(out.begin(), out.end(), [](const Finding& f) { return f.blocks.empty(); }), out.end());
+  PreferBacklashToJumplessStiction(&out);
   for (auto& f : out) f.evidence = Evidence(f);
   RankFindings(&out);
   return out;
@@ -394,6 +449,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!(holdout_fraction > 0.05 && holdout_fraction < 0.8)) return fail("holdout_fraction must be in (0.05, 0.8)");
   if (!(significance_z > 0) || !(validation_z >= 0)) return fail("significance_z > 0 and validation_z >= 0 required");
   if (!(min_improvement >= 0 && min_improvement < 1)) return fail("min_improvement must be in [0, 1)");
+  if (!(swapped_min_improvement >= 0 && swapped_min_improvement <= 1))
+    return fail("swapped_min_improvement must be in [0, 1] (1 = never swap the recordings' roles)");
   if (max_lag < 1) return fail("max_lag must be >= 1");
   if (pair_partners < 0) return fail("pair_partners must be >= 0");
   if (threads < 0) return fail("threads must be >= 0 (0 = hardware concurrency)");
@@ -525,7 +582,12 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
     return verdict;
   }
   const double excess = mse_base - sigma * sigma;
-  const double explained = verdict ? (mse_base - Mse(c.IdentResidual(verdict->fitted), c.nfit, c.n)) / excess : 0.0;
+  double explained = verdict ? (mse_base - Mse(c.IdentResidual(verdict->fitted), c.nfit, c.n)) / excess : 0.0;
+  if (verdict && verdict->swapped_tested && verdict->swapped.significant && verdict->swapped.score >= c.o.swapped_min_improvement) {
+    // Confirmed with the roles swapped: the excess is the one of the reference refitted on validation.
+    const double swapped_excess = verdict->swapped.mse_baseline - sigma * sigma;
+    explained = std::max(explained, swapped_excess > 0 ? (verdict->swapped.mse_baseline - verdict->swapped.mse) / swapped_excess : 1.0);
+  }
   if (verdict && explained >= 0.5) {
     r->nominal_status = NominalStatus::kExplainedByEffect;
     r->nominal_status_note = fmt::format("the nominal alone stays above the noise floor (held-out RMSE {:.4g} = {:.2f} x the "

@@ -125,6 +125,9 @@ std::vector<std::string> ParameterNames(Effect e) {
 bool ParameterIsSmooth(Effect e, int index) {
   if (e == Effect::kDelay || e == Effect::kQuantization) return false;
   if (e == Effect::kHysteresis && index == 0) return false;
+  // Stiction's bands decide when the stem sticks and slips: the cost jumps with them, and LM from a grid
+  // point settles on a backlash-like band (kinetic = static) instead of the stick-slip jump.
+  if (e == Effect::kStiction) return false;
   return true;
 }
 

@@ -63,7 +63,7 @@ StateVariable ParseStateVariable(const std::string& name);  // throws InputError
 std::vector<std::string> EffectVocabulary();           // every effect name, "none" last
 std::vector<std::string> ParameterNames(Effect e);     // names of EffectBlock::params
 // Whether a parameter moves the simulation smoothly (refined by Levenberg–Marquardt) or only by a
-// search (integer delay, quantization step, relay threshold).
+// search (integer delay, quantization step, relay threshold, stiction bands).
 bool ParameterIsSmooth(Effect e, int index);
 
 struct EffectBlock {

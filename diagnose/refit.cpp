@@ -246,7 +246,7 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
       break;
     case Effect::kStiction:
       for (double fs : LogSpace(1e-3 * range, 0.3 * range, 30))
-        for (double r : {0.0, 0.3, 0.6, 0.9}) g.push_back({fs, r * fs});
+        for (double r : {0.0, 0.2, 0.4, 0.6, 0.8, 1.0}) g.push_back({fs, r * fs});
       break;
     case Effect::kDeadzone: {
       // Around the signal's own zero, or near it (a band at an operating point; LM refines the centre).
@@ -330,6 +330,18 @@ Vec LocalValues(const EffectBlock& b, int index) {
   }
   if (e == Effect::kQuantization) {  // step: 0.2 % apart within +-10 %
     for (int k = -50; k <= 50; ++k) out.push_back(v * (1.0 + 0.002 * k));
+    return out;
+  }
+  if (e == Effect::kStiction) {
+    const double fs = b.params[0], fd = b.params[1];
+    if (index == 1) {  // kinetic band: anywhere from 0 to the static band
+      for (int k = 0; k <= 20; ++k) out.push_back(fs * k / 20.0);
+      return out;
+    }
+    // Static band: the kinetic band plus a stick-slip jump of up to twice the larger of the current jump
+    // and the kinetic band (from a backlash start, jump 0, the jump may open to twice the band).
+    const double jmax = 2.0 * std::max(fs - fd, fd);
+    for (int k = 0; k <= 30; ++k) out.push_back(fd + jmax * k / 30.0);
     return out;
   }
   if (e == Effect::kDelay) {
@@ -601,6 +613,18 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     SolveNumerator(&m, s, o);
     const double c = SumSquaredError(m, s);
     if (std::isfinite(c)) scored.emplace_back(c, m);
+  }
+  if (effect == Effect::kStiction) {
+    // Stiction with equal bands is backlash: the fitted backlash (linear part refitted with it) is a start
+    // from which the search opens the stick-slip jump. Its grid points alone, scored with the
+    // nominal's poles, rarely lead there: those poles smoothed the jumps away.
+    const RefitResult backlash = AddBlock(base, Effect::kBacklash, location, sv, s, o);
+    if (backlash.model.blocks.size() > base.blocks.size()) {
+      AugmentedModel m = backlash.model;
+      EffectBlock& b = m.blocks.back();
+      b = {Effect::kStiction, location, {b.params[0], b.params[0]}, sv};
+      scored.emplace_back(SumSquaredError(m, s), m);
+    }
   }
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   RefitResult best;

@@ -106,6 +106,7 @@ nlohmann::json Finding::to_json() const {
            {{"text", evidence},
             {"holdout", holdout.to_json()},
             {"validation", validation.to_json()},
+            {"swapped", swapped_tested ? swapped.to_json() : nlohmann::json(nullptr)},
             {"extra_parameters", extra_parameters},
             {"share_of_improvement_in_residual_windows", in_window_share}}}};
 }

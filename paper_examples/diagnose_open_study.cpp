@@ -5,9 +5,11 @@
 // Writes OUT/open_study.md and OUT/open_study.json (per-class rates with Wilson 95 % intervals, misses),
 // rewritten atomically after every scenario so that a run stopped early still leaves its results.
 //
-// Usage: diagnose_open_study OUT [PER_ROW] [NULLS] [FIRST_SEED] [MODES] [SHARD/SHARDS]
+// Usage: diagnose_open_study OUT [PER_ROW] [NULLS] [FIRST_SEED] [MODES] [SHARD/SHARDS] [ROWS]
 //        diagnose_open_study --merge OUT DIR...   (one table from the shards' open_study.json)
-//   defaults: PER_ROW 2, NULLS 4, FIRST_SEED 100001, MODES given,fitted, SHARD/SHARDS 0/1
+//   defaults: PER_ROW 2, NULLS 4, FIRST_SEED 100001, MODES given,fitted, SHARD/SHARDS 0/1,
+//   ROWS every effect row (or a comma-separated subset such as stiction@input,backlash@input, for
+//   development runs on the tuning seeds)
 // Seed ranges: 1..99999 are for tuning (development runs), 100001.. for the reported results.
 #include <cstdlib>
 #include <filesystem>
@@ -60,7 +62,7 @@ int Merge(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    fmt::print(stderr, "usage: diagnose_open_study OUT [PER_ROW] [NULLS] [FIRST_SEED] [given,fitted] [SHARD/SHARDS]\n"
+    fmt::print(stderr, "usage: diagnose_open_study OUT [PER_ROW] [NULLS] [FIRST_SEED] [given,fitted] [SHARD/SHARDS] [ROWS]\n"
                        "       diagnose_open_study --merge OUT DIR...\n");
     return 2;
   }
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
       o.shard = std::stoi(sh.substr(0, slash));
       o.shards = std::stoi(sh.substr(slash + 1));
     }
+    if (argc > 7) o.rows = ParseCandidates(argv[7]);
     o.diagnose.threads = 1;
     o.progress = true;
     const std::string command = CommandLine(argc, argv);
