@@ -10,8 +10,9 @@ BUILD=${BUILD:-build}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT INT TERM
 ARGS=(bounds --data paper_examples/data/cerone2011_N300.csv --noise-col noise_bound --na 2 --nb 2
-      --input-basis poly:3 --output-basis poly:3 --horizon 2 --order 2 --set exact --quiet)
-"$BUILD/cli/hwbounds" "${ARGS[@]}" --set dss --run-dir "$WORK/stage1" >/dev/null
+      --input-basis poly:3 --output-basis poly:3 --horizon 2 --order 2 --quiet)
+"$BUILD/cli/hwbounds" "${ARGS[@]}" --run-dir "$WORK/stage1" >/dev/null
+ARGS+=(--set exact)
 declare -A WALL
 for config in ${CONFIGS:-fork1 fork2 mpi3}; do
   cp -r "$WORK/stage1" "$WORK/$config"
