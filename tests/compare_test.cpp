@@ -141,20 +141,33 @@ std::map<std::string, std::vector<double>> Values(const std::vector<json>& runs,
   return v;
 }
 
-TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth) {
+// The set-membership example made small: n = 1, delta = 1 on 40 samples, seconds per run (the scenario's own
+// n = 2, delta = 2: minutes).
+Scenario SmallSetMembershipExample() {
   auto s = LoadScenario("setmembership-example");
-  s.setmembership.samples = 40;  // n = 1, delta = 1: seconds per run (the scenario's own n = 2, delta = 2: minutes)
+  s.setmembership.samples = 40;
   s.setmembership.horizon = 1;
   s.setmembership.order = 1;
   s.esmaeilani.samples = 150;
   s.validation.samples = 200;
+  return s;
+}
+
+// Quiet study options on 2 workers, writing into a fresh folder under the test's temporary directory.
+StudyOptions SmallStudy(int runs, std::uint64_t seed, const std::string& folder) {
   StudyOptions o;
-  o.runs = 3;
-  o.seed = 11;
+  o.runs = runs;
+  o.seed = seed;
   o.jobs = 2;
   o.quiet = true;
-  o.out_dir = ::testing::TempDir() + "/compare_small";
+  o.out_dir = ::testing::TempDir() + "/" + folder;
   fs::remove_all(o.out_dir);
+  return o;
+}
+
+TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth) {
+  const auto s = SmallSetMembershipExample();
+  StudyOptions o = SmallStudy(3, 11, "compare_small");
   const auto r = RunStudy(o, s);
   EXPECT_EQ(r.runs_computed, 3);
   for (const char* f : {"summary.md", "summary.json", "scenario.json", "plots/plots.gp"})
@@ -230,21 +243,10 @@ TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth
   EXPECT_EQ(r2.summary["methods"].dump(), summary["methods"].dump());
 }
 
-
 TEST(CompareStudy, TheExactSetIsAMethodInsideTheOuterSetAndAroundTheTruth) {
-  auto s = LoadScenario("setmembership-example");
-  s.setmembership.samples = 40;
-  s.setmembership.horizon = 1;
-  s.setmembership.order = 1;
-  s.validation.samples = 200;
-  StudyOptions o;
-  o.runs = 2;
-  o.seed = 21;
-  o.jobs = 2;
-  o.quiet = true;
+  const auto s = SmallSetMembershipExample();
+  StudyOptions o = SmallStudy(2, 21, "compare_exact");
   o.methods = {"setmembership", "exact"};
-  o.out_dir = ::testing::TempDir() + "/compare_exact";
-  fs::remove_all(o.out_dir);
   const auto r = RunStudy(o, s);
   EXPECT_TRUE(r.coverage_ok);
   const auto truth = CeroneExample::TrueParameters();
