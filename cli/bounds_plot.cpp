@@ -122,7 +122,7 @@ std::string Script(const dss::BoundsSummary& s, bool with_truth, const std::stri
   gp += "set key below vertical maxrows 3\n";  // one column: it fits the panel's width
   if (with_exact) {
     const std::string truth_in = with_truth ? ", 'intervals.dat' using 15:1 with points pt 13 ps 2 lc rgb '#d62728' title 'truth'" : "";
-    gp += "set title 'within each interval of D (0: lower end, 1: upper end)'\nset xrange [-0.1:1.1]\n";
+    gp += "set title 'within the intervals of D (0: lower, 1: upper end)'\nset xrange [-0.1:1.1]\n";
     gp += "plot 'intervals.dat' using (0):1:(1):(0):ytic(12) with vectors nohead lw 7 lc rgb '#ff7f0e' title 'exact set D interval (outer)', "
           "'' using 13:($1+0.25):($14-$13):(0) with vectors nohead lw 3 lc rgb '#2ca02c' title 'inner hull (points of D)'" +
           truth_in + "\n";
