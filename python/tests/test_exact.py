@@ -29,3 +29,9 @@ def test_unknown_set_is_a_value_error(recording):
     _, rec = recording
     with pytest.raises(ValueError, match="set 'exactly' unknown"):
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, set="exactly")
+
+
+def test_unknown_lp_solver_is_a_value_error_before_any_work(recording):
+    _, rec = recording
+    with pytest.raises(ValueError, match="LP solver 'highs' unknown; expected one of: clp, glpk"):
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, set="exact", lp_solver="highs")
