@@ -130,9 +130,20 @@ std::vector<std::pair<double, double>> PriorBox(const Scenario& s, const SetMemb
   return box;
 }
 
-// The D^ss(n) run of the set-membership experiment, in this process (runs are already spread over workers).
-dss::BoundsSummary ComputeOuterSet(const Scenario& s, const dss::HwOuterSet& set) {
+// The D^ss(n) run of the set-membership experiment on one record, in this process (runs are already spread over
+// workers). Both set-membership methods report from it: the exact set starts in its box.
+struct OuterSetRun {
+  std::vector<std::pair<double, double>> box;
+  dss::HwData data;
+  dss::HwOuterSet set;
+  dss::BoundsSummary summary;
+};
+
+OuterSetRun RunOuterSet(const Scenario& s, const SetMembershipClass& cls, const Record& rec, double bound) {
   const auto& sm = s.setmembership;
+  const auto box = PriorBox(s, cls);
+  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
+  dss::HwOuterSet set(cls.structure, data, sm.horizon, box);
   dss::BoundsOptions o;
   o.order = sm.order;
   o.solver = sm.solver;
@@ -141,7 +152,8 @@ dss::BoundsSummary ComputeOuterSet(const Scenario& s, const dss::HwOuterSet& set
   o.executor = std::make_shared<sdp::InProcessExecutor>();
   std::string err;
   if (!o.IsValid(&err)) throw InputError("setmembership options: " + err);
-  return dss::ComputeBounds(o, set);
+  dss::BoundsSummary summary = dss::ComputeBounds(o, set);
+  return {box, std::move(data), std::move(set), std::move(summary)};
 }
 
 // One interval as the comparison reports it.
@@ -190,15 +202,12 @@ void ReportIntervals(const Scenario& s, const SetMembershipClass& cls, const std
   }
 }
 
-json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Record& rec, double bound,
+json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const OuterSetRun& run, double bound,
                       const Record& val) {
   json out = {{"applicable", true}};
-  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
-  const auto box = PriorBox(s, cls);
-  const dss::HwOuterSet set(cls.structure, data, s.setmembership.horizon, box);
-  const auto summary = ComputeOuterSet(s, set);
+  const auto& summary = run.summary;
   out["noise_bound"] = bound;
-  out["samples"] = rec.u.size();
+  out["samples"] = run.data.u.size();
   out["orthants"] = {{"total", summary.orthants_total}, {"empty", summary.orthants_empty},
                      {"solved", summary.orthants_solved}, {"failed", summary.orthants_failed}};
   out["sdp_solves"] = summary.sdp_solves;
@@ -206,24 +215,28 @@ json RunSetMembership(const Scenario& s, const SetMembershipClass& cls, const Re
   for (const auto& iv : summary.intervals)
     ivs.push_back({iv.name, iv.lower.value, iv.upper.value, dss::ToString(iv.lower.status),
                    dss::ToString(iv.upper.status), {}});
-  ReportIntervals(s, cls, ivs, box, summary.all_guaranteed(), 1e-6 /* SDP solver accuracy */, val, &out);
+  ReportIntervals(s, cls, ivs, run.box, summary.all_guaranteed(), 1e-6 /* SDP solver accuracy */, val, &out);
   return out;
 }
 
 // The exact set D on the same record: stage 1 is the D^ss(n) run above, stage 2 bounds D inside its box
 // (exact/exact_bounds.hpp), with an inner hull so every interval shows its tightness.
-json RunExactSet(const Scenario& s, const SetMembershipClass& cls, const Record& rec, double bound, const Record& val) {
+json RunExactSet(const Scenario& s, const SetMembershipClass& cls, const OuterSetRun& run, double bound,
+                 const Record& val) {
   json out = {{"applicable", true}};
-  dss::HwData data{rec.u, rec.y, std::vector<double>(rec.y.size(), bound), "compare run"};
-  const auto box = PriorBox(s, cls);
-  const dss::HwOuterSet set(cls.structure, data, s.setmembership.horizon, box);
-  const auto outer = ComputeOuterSet(s, set);
+  out["noise_bound"] = bound;
+  out["samples"] = run.data.u.size();
+  out["stage1_seconds"] = run.summary.wall_seconds;  // the D^ss(n) run, shared with `setmembership`
+  if (run.summary.invalidated()) {
+    out["status"] = "failed";
+    out["message"] = "D^ss(n) is empty (certified), and D with it: no model of the class explains the record";
+    return out;
+  }
   exact::ExactBoundsOptions o;
   o.executor = std::make_shared<sdp::InProcessExecutor>();
   o.parameters = s.setmembership.parameters;
-  const auto summary = exact::ComputeExactBounds(o, cls.structure, data, exact::StartBoxFromOuter(outer, set));
-  out["noise_bound"] = bound;
-  out["samples"] = rec.u.size();
+  const auto summary =
+      exact::ComputeExactBounds(o, cls.structure, run.data, exact::StartBoxFromOuter(run.summary, run.set));
   out["assumption"] = summary.assumption.to_json();
   out["invalidated"] = summary.invalidated;
   out["stage2"] = summary.to_json().at("stage2");
@@ -243,7 +256,7 @@ json RunExactSet(const Scenario& s, const SetMembershipClass& cls, const Record&
     all_guaranteed = all_guaranteed && iv.lower.status != exact::EndpointStatus::kConservative &&
                      iv.upper.status != exact::EndpointStatus::kConservative;
   }
-  ReportIntervals(s, cls, ivs, box, all_guaranteed, 0.0 /* certified bounds: no tolerance */, val, &out);
+  ReportIntervals(s, cls, ivs, run.box, all_guaranteed, 0.0 /* certified bounds: no tolerance */, val, &out);
   return out;
 }
 
@@ -522,6 +535,12 @@ nlohmann::json RunOne(const Scenario& s, const std::vector<std::string>& methods
                               seed, &bound);
     out["noise_bound"] = bound;
   }
+  // The D^ss(n) run, once per run however many set-membership methods report from it.
+  std::optional<OuterSetRun> outer;
+  auto outer_set = [&]() -> const OuterSetRun& {
+    if (!outer) outer.emplace(RunOuterSet(s, SetMembershipTruth(s.plant), smrec, bound));
+    return *outer;
+  };
   for (const auto& method : methods) {
     const auto app = MethodApplies(s, method);
     json m;
@@ -533,9 +552,9 @@ nlohmann::json RunOne(const Scenario& s, const std::vector<std::string>& methods
     const auto t0 = std::chrono::steady_clock::now();
     try {
       if (method == "setmembership") {
-        m = RunSetMembership(s, SetMembershipTruth(s.plant), smrec, bound, val);
+        m = RunSetMembership(s, SetMembershipTruth(s.plant), outer_set(), bound, val);
       } else if (method == "exact") {
-        m = RunExactSet(s, SetMembershipTruth(s.plant), smrec, bound, val);
+        m = RunExactSet(s, SetMembershipTruth(s.plant), outer_set(), bound, val);
       } else if (method == "esmaeilani") {
         std::vector<Record> recs;
         for (int k = 0; k < s.esmaeilani.segments; ++k) {
