@@ -134,13 +134,30 @@ struct Context {
   }
 };
 
+// A richer nominal structure fitted on the fitting part, with its residuals (see Richer).
+struct RicherFit {
+  std::string name;
+  AugmentedModel fitted;
+  Vec ident_residual;
+  Vec valid_residual;       // refitted on the whole identification recording; empty unless it could replace
+  AugmentedModel full;      // that refit
+  int extra_parameters = 0;
+  Comparison holdout, validation;  // against the baseline
+};
+
 // What a candidate is compared against: a model fitted on the fitting part and its residuals.
 struct Reference {
   AugmentedModel fitted;  // on the fitting part
   Vec ident_residual;     // of `fitted` on the identification recording
   Vec valid_residual;     // of the reference refitted on the whole identification recording
+  AugmentedModel full;    // the reference refitted on the whole identification recording
   Vec swapped_residual;   // of the reference refitted on the validation recording, on the identification one
   double richer_score = 0.0;  // penalised held-out score of the best richer nominal against `fitted`
+  // Validation score of the richer nominal that beat `fitted` significantly on both parts (-inf: none
+  // did); an effect must then beat it on validation too, or the richer nominal becomes the baseline.
+  double richer_validation_score = -HUGE_VAL;
+  std::vector<RicherFit> richer;  // every richer structure tried
+  int replacement = -1;           // index into richer of the one that would replace the baseline
 };
 
 // A block whose parameters describe no physical device: a dead band so wide that the signal spends
@@ -157,6 +174,30 @@ bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t s
   return b.params[0] < Median(mag) && std::abs(b.params[1] - Median(v)) <= 0.25 * spread;
 }
 
+// When only one of the two tests confirms a candidate, its two fits may sit in different optima: the
+// fit on the fitting part (judged on the held-out tail) and its refit on the whole recording (judged on
+// validation) started from it. The part that did not confirm is refitted from the other fit's numbers
+// and, for the whole recording, from the block's own grid as well; a new fit is kept only when it lowers
+// the cost on its own training data (never chosen by the part it is judged on).
+void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Location location, LimitSides sides,
+                   Finding* f) {
+  if (!f->holdout.significant) {
+    const AugmentedModel alt = RefitModel(f->model, c.fit, c.o.refit).model;
+    if (SumSquaredError(alt, c.fit) < SumSquaredError(f->fitted, c.fit)) {
+      f->fitted = alt;
+      f->blocks = alt.blocks;
+      f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(alt), c.nfit, c.n, f->extra_parameters, c.o.significance_z);
+    }
+    return;
+  }
+  const AugmentedModel alt = AddBlock(ref.full, effect, location, c.o.state_variable, c.full, c.o.refit, sides).model;
+  if (alt.blocks.size() == f->model.blocks.size() && SumSquaredError(alt, c.full) < SumSquaredError(f->model, c.full)) {
+    f->model = alt;
+    f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(alt), c.skip, c.nv, f->extra_parameters,
+                              c.o.validation_z);
+  }
+}
+
 Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
   // Saturation-type blocks: one-sided and two-sided limits are different structures, chosen by the
   // penalised held-out score (a second limit must earn its parameter).
@@ -165,6 +206,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
     variants = {LimitSides::kUpper, LimitSides::kLower, LimitSides::kBoth};
   Finding f;
   bool have = false;
+  LimitSides chosen = LimitSides::kAny;
   for (const LimitSides sides : variants) {
     const RefitResult fit = AddBlock(ref.fitted, effect, location, c.o.state_variable, c.fit, c.o.refit, sides);
     if (fit.model.blocks.size() <= ref.fitted.blocks.size()) continue;
@@ -176,15 +218,17 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
     f.blocks = fit.model.blocks;
     f.extra_parameters = k;
     f.holdout = h;
+    chosen = sides;
   }
   if (!have) return f;
+  f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
+  f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
+                           c.o.validation_z);
+  if (f.holdout.significant != f.validation.significant) ReconcileFits(c, ref, effect, location, chosen, &f);
   bool meaningful = true;
   for (const auto& b : f.blocks)
     if (b.location != Location::kState)
       meaningful = meaningful && PhysicallyMeaningful(b, b.location == Location::kInput ? c.ident.u : c.ident.y, c.skip);
-  f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
-  const Vec v1 = c.ValidationResidual(f.model);
-  f.validation = c.Compare(ref.valid_residual, v1, c.skip, c.nv, f.extra_parameters, c.o.validation_z);
   // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
   // the fitting part): a candidate that validation confirms may then pass the first test with the
   // recordings' roles swapped instead (refitted on the validation recording, scored on the whole
@@ -202,7 +246,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
   f.score = 1.0 - std::sqrt(ph * pv);
   // Robust to the nominal: the block must also do better than a richer nominal on the held-out tail.
-  f.beats_richer = first.score >= ref.richer_score;
+  f.beats_richer = first.score >= ref.richer_score && f.validation.score >= ref.richer_validation_score;
   f.meaningful = meaningful;
   f.eligible = first.significant && f.validation.significant && f.beats_richer && meaningful;
   return f;
@@ -247,8 +291,12 @@ bool DelayExplainsAsWell(const Context& c, const Reference& ref, double richer_s
 
 // Richer nominal structures than `spec`: one more pole and numerator coefficient, and, for structures
 // with polynomial maps, two more degrees on each map. Every effect must beat the best of them on the
-// held-out tail (penalised for their extra parameters); when one beats the baseline significantly on
-// both the held-out tail and validation, the nominal structure is too poor and it becomes the baseline.
+// held-out tail (penalised for their extra parameters). One that beats the baseline significantly on
+// both the held-out tail and validation is kept as the replacement (`ref->replacement`): an effect
+// must then beat it on validation too, and when none does, the nominal structure was too poor and the
+// replacement becomes the baseline (ReplaceByRicher). Effects are tried on the nominal structure first:
+// a richer map or numerator absorbs part of a concealed effect, so an effect sought on top of it is
+// sought on a distorted model.
 void Richer(const Context& c, const NominalSpec& spec, Reference* ref, DiagnoseReport* r) {
   std::vector<NominalSpec> richer;
   NominalSpec orders = spec;
@@ -265,32 +313,62 @@ void Richer(const Context& c, const NominalSpec& spec, Reference* ref, DiagnoseR
   no.refit = c.o.refit;
   double best = -HUGE_VAL;
   for (const NominalSpec& s : richer) {
-    NominalFit fit;
+    RicherFit rf;
     try {
-      fit = FitNominal(s, c.fit, no);
+      rf.fitted = FitNominal(s, c.fit, no).model;
     } catch (const InputError&) {
       continue;  // too short a fitting part for the structure
     }
-    const int k = count(s) - count(spec);
-    const Vec e = c.IdentResidual(fit.model);
-    const Comparison h = c.Compare(ref->ident_residual, e, c.nfit, c.n, k, c.o.significance_z);
+    rf.name = s.Text();
+    rf.extra_parameters = count(s) - count(spec);
+    rf.ident_residual = c.IdentResidual(rf.fitted);
+    rf.holdout = c.Compare(ref->ident_residual, rf.ident_residual, c.nfit, c.n, rf.extra_parameters, c.o.significance_z);
     r->richer_note += fmt::format("{}{}: held-out MSE {:.3g}x the baseline's (penalised score {:.3f}, z = {:.1f})",
-                                  r->richer_note.empty() ? "" : "; ", s.Text(), h.ratio, h.score, h.z);
-    if (h.significant && !DelayExplainsAsWell(c, *ref, h.score)) {
-      const Vec v = c.ValidationResidual(RefitModel(fit.model, c.full, c.o.refit).model);
-      if (c.Compare(ref->valid_residual, v, c.skip, c.nv, k, c.o.validation_z).significant) {
-        r->richer_note += " — better on validation too: it replaces the baseline";
-        r->baseline_source = "richer nominal " + s.Text();
-        ref->fitted = fit.model;
-        ref->ident_residual = e;
-        ref->valid_residual = v;
-        best = -HUGE_VAL;  // earlier scores were against the replaced baseline
-        continue;
+                                  r->richer_note.empty() ? "" : "; ", rf.name, rf.holdout.ratio, rf.holdout.score,
+                                  rf.holdout.z);
+    best = std::max(best, rf.holdout.score);
+    if (rf.holdout.significant && !DelayExplainsAsWell(c, *ref, rf.holdout.score)) {
+      rf.full = RefitModel(rf.fitted, c.full, c.o.refit).model;
+      rf.valid_residual = c.ValidationResidual(rf.full);
+      rf.validation = c.Compare(ref->valid_residual, rf.valid_residual, c.skip, c.nv, rf.extra_parameters, c.o.validation_z);
+      if (rf.validation.significant) {
+        r->richer_note += fmt::format(" — better on validation too (penalised score {:.3f}): an effect must beat it there",
+                                      rf.validation.score);
+        const bool better = ref->replacement < 0 || rf.holdout.score + rf.validation.score >
+                                                        ref->richer[ref->replacement].holdout.score +
+                                                            ref->richer[ref->replacement].validation.score;
+        if (better) {
+          ref->replacement = static_cast<int>(ref->richer.size());
+          ref->richer_validation_score = rf.validation.score;
+        }
       }
     }
-    best = std::max(best, h.score);
+    ref->richer.push_back(std::move(rf));
   }
   ref->richer_score = std::max(best, 0.0);
+}
+
+// No effect beat the replacement richer nominal: it becomes the baseline, and the other richer
+// structures are scored against it.
+Reference ReplaceByRicher(const Context& c, const Reference& ref, DiagnoseReport* r) {
+  const RicherFit& rep = ref.richer[ref.replacement];
+  Reference out;
+  out.fitted = rep.fitted;
+  out.ident_residual = rep.ident_residual;
+  out.valid_residual = rep.valid_residual;
+  out.full = rep.full;
+  double best = 0.0;
+  for (std::size_t i = 0; i < ref.richer.size(); ++i) {
+    if (static_cast<int>(i) == ref.replacement) continue;
+    const int k = std::max(ref.richer[i].extra_parameters - rep.extra_parameters, 0);
+    best = std::max(best, c.Compare(out.ident_residual, ref.richer[i].ident_residual, c.nfit, c.n, k, c.o.significance_z).score);
+  }
+  out.richer_score = best;
+  if (c.o.swapped_min_improvement < 1.0)
+    out.swapped_residual = c.SwappedResidual(RefitModel(out.fitted, c.full, c.o.refit).model);
+  r->richer_note += fmt::format("; no effect beat {} on both: it replaces the baseline", rep.name);
+  r->baseline_source = "richer nominal " + rep.name;
+  return out;
 }
 
 // Baseline: the nominal refitted alone, from the given numbers and (structure known) fresh starts.
@@ -322,7 +400,8 @@ Reference Baseline(const Context& c, const AugmentedModel& nominal, const Nomina
   Reference ref;
   ref.fitted = best;
   ref.ident_residual = c.IdentResidual(best);
-  ref.valid_residual = c.ValidationResidual(RefitModel(best, c.full, c.o.refit).model);
+  ref.full = RefitModel(best, c.full, c.o.refit).model;
+  ref.valid_residual = c.ValidationResidual(ref.full);
   if (c.o.richer_nominal && (structure || NominalSpec::Of(nominal.nominal, &spec)))
     Richer(c, structure ? *structure : spec, &ref, r);
   if (c.o.swapped_min_improvement < 1.0)
@@ -361,6 +440,7 @@ std::vector<Finding> SearchPairs(const Context& c, const Finding& single, const 
   Reference ref;
   ref.fitted = single.fitted;
   ref.ident_residual = c.IdentResidual(ref.fitted);
+  ref.full = single.model;
   ref.valid_residual = c.ValidationResidual(single.model);
   std::vector<std::pair<Effect, Location>> partners;
   for (const auto& f : ranked) {
@@ -719,8 +799,12 @@ void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const Nom
   r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, c.skip, o.max_lag);
 
   // Baseline, every single block, and a combination of two when it beats the best single one.
-  const Reference base = Baseline(c, nominal, structure, &r);
+  Reference base = Baseline(c, nominal, structure, &r);
   r.findings = SearchSingles(c, base);
+  if (base.replacement >= 0 && (r.findings.empty() || !r.findings.front().eligible)) {
+    base = ReplaceByRicher(c, base, &r);
+    r.findings = SearchSingles(c, base);
+  }
   r.nominal_refit_model = RefitModel(base.fitted, c.full, o.refit).model;
   r.noise_estimated = !(o.noise_std > 0);
   r.noise_std = NoiseLevel(c, e_nom, base, r.findings);
