@@ -355,25 +355,64 @@ Vec LocalValues(const EffectBlock& b, int index) {
   return out;
 }
 
-// Local search of every search-only parameter, then LM again.
+// Scans parameter i of block b over `values` (numerator, offset and initial state re-solved at each) and
+// moves it to the middle of the run of values whose cost ties with the best. A threshold between two
+// levels of a step or PRBS input changes nothing on the data anywhere between them, and the middle of
+// that interval is the choice that does not sit at the edge of what the data show. The model only
+// changes when the chosen value costs no more than the current model. Returns whether the run reached an
+// end of `values` (the tie may extend beyond them).
+bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& values, const Segment& s,
+                  const RefitOptions& o) {
+  std::vector<std::pair<double, std::pair<double, AugmentedModel>>> tried;  // value -> (cost, model)
+  for (double v : values) {
+    AugmentedModel t = *m;
+    t.blocks[b].params[i] = v;
+    std::string err;
+    if (!t.blocks[b].IsValid(&err)) continue;
+    SolveNumerator(&t, s, o);
+    const double c = SumSquaredError(t, s);
+    if (std::isfinite(c)) tried.push_back({v, {c, std::move(t)}});
+  }
+  if (tried.empty()) return false;
+  std::sort(tried.begin(), tried.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < tried.size(); ++k)
+    if (tried[k].second.first < tried[best].second.first) best = k;
+  const double cmin = tried[best].second.first, tol = 1e-9 * cmin;
+  std::size_t lo = best, hi = best;
+  while (lo > 0 && tried[lo - 1].second.first <= cmin + tol) --lo;
+  while (hi + 1 < tried.size() && tried[hi + 1].second.first <= cmin + tol) ++hi;
+  const double current = SumSquaredError(*m, s);
+  if (cmin > current + 1e-9 * current) return false;
+  *m = tried[(lo + hi) / 2].second.second;
+  return lo == 0 || hi + 1 == tried.size();
+}
+
+// Whether the cost is flat around parameter i of block b (1 % either side): a smooth parameter between
+// two levels of a piecewise-constant signal, which LM cannot move.
+bool FlatAround(const AugmentedModel& m, std::size_t b, std::size_t i, const Segment& s) {
+  const double v = m.blocks[b].params[i], c = SumSquaredError(m, s);
+  if (!std::isfinite(v) || v == 0.0) return false;
+  for (double f : {0.99, 1.01}) {
+    AugmentedModel t = m;
+    t.blocks[b].params[i] = v * f;
+    std::string err;
+    if (!t.blocks[b].IsValid(&err) || std::abs(SumSquaredError(t, s) - c) > 1e-9 * c) return false;
+  }
+  return true;
+}
+
+// Local search of every search-only parameter (and of smooth ones on a flat cost), centred in the run
+// of tied values and repeated while that run reaches the end of the local values; then LM again.
 void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
   bool any = false;
   for (std::size_t b = 0; b < m->blocks.size(); ++b)
     for (std::size_t i = 0; i < m->blocks[b].params.size(); ++i) {
-      if (ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i))) continue;
+      const bool smooth = ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i));
+      if (smooth && !FlatAround(*m, b, i, s)) continue;
       any = true;
-      double best = SumSquaredError(*m, s);
-      AugmentedModel best_m = *m;
-      for (double v : LocalValues(m->blocks[b], static_cast<int>(i))) {
-        AugmentedModel t = *m;
-        t.blocks[b].params[i] = v;
-        std::string err;
-        if (!t.blocks[b].IsValid(&err)) continue;
-        SolveNumerator(&t, s, o);
-        const double c = SumSquaredError(t, s);
-        if (c < best) best = c, best_m = t;
-      }
-      *m = best_m;
+      for (int pass = 0; pass < 3; ++pass)
+        if (!CentreInTies(m, b, i, LocalValues(m->blocks[b], static_cast<int>(i)), s, o)) break;
     }
   if (any) Lm(m, Packing::For(*m, o), s, o.lm);
 }
