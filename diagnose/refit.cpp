@@ -359,8 +359,10 @@ Vec LocalValues(const EffectBlock& b, int index) {
 // moves it to the middle of the run of values whose cost ties with the best. A threshold between two
 // levels of a step or PRBS input changes nothing on the data anywhere between them, and the middle of
 // that interval is the choice that does not sit at the edge of what the data show. The model only
-// changes when the chosen value costs no more than the current model. Returns whether the run reached an
-// end of `values` (the tie may extend beyond them).
+// changes when the chosen value costs no more than the current model. Stiction's bands are the
+// exception: within a tie they take the end nearest to backlash (the smallest static band, the largest
+// kinetic band), so that a stick-slip jump the data do not show is not invented. Returns whether the run
+// reached an end of `values` (the tie may extend beyond them).
 bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& values, const Segment& s,
                   const RefitOptions& o) {
   std::vector<std::pair<double, std::pair<double, AugmentedModel>>> tried;  // value -> (cost, model)
@@ -384,8 +386,10 @@ bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& va
   while (hi + 1 < tried.size() && tried[hi + 1].second.first <= cmin + tol) ++hi;
   const double current = SumSquaredError(*m, s);
   if (cmin > current + 1e-9 * current) return false;
-  *m = tried[(lo + hi) / 2].second.second;
-  return lo == 0 || hi + 1 == tried.size();
+  const bool stiction = m->blocks[b].effect == Effect::kStiction;
+  const std::size_t pick = stiction ? (i == 0 ? lo : hi) : (lo + hi) / 2;
+  *m = tried[pick].second.second;
+  return stiction ? (pick == 0 || pick + 1 == tried.size()) && lo != hi : lo == 0 || hi + 1 == tried.size();
 }
 
 // Whether the cost is flat around parameter i of block b (1 % either side): a smooth parameter between
