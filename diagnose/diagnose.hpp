@@ -7,7 +7,10 @@
 //     identification recording, from the given numbers and, when the structure is known, from several
 //     fresh starts (nominal_fit.hpp); the best by held-out error is the baseline every candidate must
 //     beat. A bad nominal fit is therefore never blamed on an effect: the nominal refit is itself a
-//     candidate and is reported as such.
+//     candidate and is reported as such. Richer structures (orders + 1, map degrees + 2) are fitted too:
+//     every effect must beat them on the held-out tail, and one that beats the baseline on both parts
+//     must be beaten on validation as well; only when no effect does it becomes the baseline (the effects
+//     are then sought again on top of it).
 //  2. Search — every candidate block (effects.hpp) is added to the baseline and refitted on the
 //     fitting part (in parallel), scored on the held-out tail, refitted on the whole identification
 //     recording and scored on the validation recording. Scores are MSE ratios to the baseline,
@@ -18,7 +21,9 @@
 //     min_improvement) and on validation (z >= validation_z, reduction >= min_improvement); when only
 //     validation is, the first test is repeated with the recordings' roles swapped (refit on validation,
 //     scored on identification, as strict as validation) and stands in for the held-out one; the
-//     verdict is the eligible candidate with the best combined (geometric-mean) penalised score.
+//     verdict is the eligible candidate with the best combined (geometric-mean) penalised score. When only
+//     one of the two tests confirms a candidate, the other fit is restarted from the confirmed one (and,
+//     on the whole recording, from the block's grid) and kept when its own training cost drops.
 //  3. Combination — when a verdict exists, pairs of it with the next candidates are tried and kept
 //     only if the pair beats the single block by the same two tests.
 //  4. Locate — the mismatch windows are the samples where the verdict's blocks change the
