@@ -215,6 +215,30 @@ TEST(Refit, BacklashWidthIsRecoveredJointlyWithTheLinearBlock) {
   EXPECT_NEAR(r.model.nominal.linear.a[0], sc.truth.nominal.linear.a[0], 0.02);
 }
 
+// A relay threshold between two levels of a step input fits the data equally well anywhere between
+// them; the grid (quantiles of |u|: the levels themselves) puts it on the lower level, and the fit must
+// move it inside the interval (here (0.6, 1.0)), where a new level in between is predicted sensibly.
+TEST(Refit, AThresholdBetweenTwoInputLevelsIsPlacedInsideTheInterval) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> pick(0, 5), hold(8, 30);
+  const Vec levels = {-1.0, -0.6, -0.2, 0.2, 0.6, 1.0};
+  Vec u;
+  while (u.size() < 900) u.insert(u.end(), hold(rng), levels[pick(rng)]);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.8}, {0.2}, 0};
+  truth.blocks.push_back({Effect::kHysteresis, Location::kInput, {0.8, 0.3}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, 0.01);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  AugmentedModel nominal = truth.WithoutBlocks();
+  const RefitResult r = AddBlock(nominal, Effect::kHysteresis, Location::kInput, StateVariable::kPosition, seg, {});
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_GT(r.model.blocks[0].params[0], 0.65);
+  EXPECT_LT(r.model.blocks[0].params[0], 0.95);
+  EXPECT_NEAR(r.model.blocks[0].params[1], 0.3, 0.03);
+}
+
 // Data from a mass–spring–damper whose "friction" pushes along the motion (a negative Coulomb level):
 // an unconstrained fit returns a negative coefficient; the diagnosis must never report one.
 TEST(Refit, FrictionIsNeverReportedWithANegativeLevel) {
