@@ -13,6 +13,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Ended with an answer: optimal, or stopped at the objective cutoff.
+bool Solved(LpStatus status) { return status == LpStatus::kOptimal || status == LpStatus::kCutoff; }
+
 // The slack LP of a window: a rigorous lower bound of the largest residual, and the solve itself.
 struct SlackSolve {
   double lower_bound = -1.0;
@@ -24,7 +27,9 @@ SlackSolve SolveSlack(const LiftedData& data, const ParamBox& box, Window window
   LiftedLp lifted = BuildLiftedLp(data, box, window, LiftedForm::kFeasibility);
   lifted.SetSlackObjective();
   SlackSolve out;
-  out.result = solver.Solve(lifted.lp, warm, options.lp);
+  LpSolveOptions lp = options.lp;
+  lp.objective_cutoff = 0.0;  // a positive residual bound is all a pruning test needs
+  out.result = solver.Solve(lifted.lp, warm, lp);
   // Any dual vector certifies: even a solve that stopped early may prove the box empty.
   if (!out.result.duals.empty()) out.lower_bound = SafeLowerBound(lifted.lp, out.result.duals);
   return out;
@@ -97,7 +102,7 @@ BoxEvaluation TestBoxEmpty(const LiftedData& data, const ParamBox& box, const Bo
     const bool whole = w == WholeRecord(data);
     SlackSolve s = SolveSlack(data, box, w, options, solver, whole ? warm : LpBasis{});
     ++out.lps;
-    if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
+    if (!Solved(s.result.status)) ++out.lp_failures;
     if (s.lower_bound > 0.0) {
       out.verdict = BoxVerdict::kPruned;
       out.certificate = PruneCertificate{w, s.lower_bound};
@@ -120,12 +125,18 @@ struct BoundSolve {
   LpResult result;
 };
 
+// Any dual vector certifies, so a solve that stopped short (iteration limit, stall) still gives a bound, only
+// a looser one; an LP found infeasible goes to the emptiness test instead.
 BoundSolve SolveBound(LiftedLp& lifted, LpSolver& solver, const LpBasis& warm, const LpSolveOptions& options) {
   BoundSolve out;
   out.result = solver.Solve(lifted.lp, warm, options);
-  if (out.result.status == LpStatus::kOptimal) out.lower_bound = SafeLowerBound(lifted.lp, out.result.duals);
+  if (out.result.status != LpStatus::kInfeasible && !out.result.duals.empty())
+    out.lower_bound = SafeLowerBound(lifted.lp, out.result.duals);
   return out;
 }
+
+// A bound to use: from an optimal solve, or a finite one from a solve that stopped short.
+bool Usable(const BoundSolve& s) { return s.result.status == LpStatus::kOptimal || std::isfinite(s.lower_bound); }
 
 }  // namespace
 
@@ -152,10 +163,8 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     lifted.SetParameterObjective(weights);
     BoundSolve s = SolveBound(lifted, solver, warm, options.lp);
     ++out.lps;
-    if (s.result.status != LpStatus::kOptimal) {
-      ++out.lp_failures;
-      return failed_lp();
-    }
+    if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
+    if (!Usable(s)) return failed_lp();
     out.bound = sign * s.lower_bound;
     out.lp_value = sign * s.result.objective;
     out.point = ParameterValues(lifted, s.result.primal);
@@ -175,8 +184,8 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
       for (double& c : lifted.lp.obj) c *= sigma * sign;
       BoundSolve s = SolveBound(lifted, solver, basis, options.lp);
       ++out.lps;
-      if (s.result.status != LpStatus::kOptimal) {
-        ++out.lp_failures;
+      if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
+      if (!Usable(s)) {
         if (best) break;
         return failed_lp();
       }

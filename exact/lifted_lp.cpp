@@ -35,6 +35,8 @@ class RowBuilder {
   // sum >= rhs (the exact rhs lies in the interval).
   void AtLeast(Interval rhs) { Finish(rhs.mid(), kInf, rhs.rad(), 0.0); }
   void AtMost(Interval rhs) { Finish(-kInf, rhs.mid(), 0.0, rhs.rad()); }
+  void EqualTo(double rhs) { Finish(rhs, rhs, 0.0, 0.0); }
+  void Free() { Finish(-kInf, kInf, 0.0, 0.0); }
 
  private:
   void Finish(double lo, double hi, double lo_rad, double hi_rad) {
@@ -177,14 +179,20 @@ LiftedLp BuildLiftedLp(const LiftedData& d, const ParamBox& box, Window window, 
   out.s_col = lp.AddColumn(0.0, form == LiftedForm::kFeasibility ? RoundUp(slack_max) : 0.0);
 
   RowBuilder row(&lp);
-  // Equations: -s <= residual_t <= s.
+  // Equations: -s <= residual_t <= s. In the bounding form (s = 0) the first row is the equation itself and the
+  // second is left free: the same shape as the feasibility form (so a basis carries over), but no pair of
+  // opposite inequalities that would leave an interior-point method no interior.
   for (int t = t_first; t < window.end; ++t) {
     for (int side = 0; side < 2; ++side) {
       row.Add(z_col(t), 1.0);
       for (int i = 1; i <= na; ++i) row.Add(w_col[i][t - i - window.begin], 1.0);
       for (int j = j0; j <= nb; ++j)
         for (int k = 1; k <= n_gamma; ++k) row.Add(out.beta_col[j - j0][k - 1], -d.psi[t - j][k - 1]);
-      if (side == 0) {
+      if (form == LiftedForm::kBounding) {
+        row.Add(out.s_col, side == 0 ? -1.0 : 1.0);
+        if (side == 0) row.EqualTo(0.0);
+        else row.Free();
+      } else if (side == 0) {
         row.Add(out.s_col, -1.0).AtMost(0.0);
       } else {
         row.Add(out.s_col, 1.0).AtLeast(0.0);

@@ -1,17 +1,21 @@
 #include "exact/lp_solver.hpp"
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "exact/clp_solver.hpp"
+#include "exact/fallback_solver.hpp"
 #include "exact/glpk_solver.hpp"
+#include "exact/ipm_solver.hpp"
 
 namespace hw::exact {
 
 std::string ToString(LpStatus status) {
   switch (status) {
     case LpStatus::kOptimal: return "optimal";
+    case LpStatus::kCutoff: return "cutoff";
     case LpStatus::kInfeasible: return "infeasible";
     case LpStatus::kUnbounded: return "unbounded";
     case LpStatus::kIterationLimit: return "iteration limit";
@@ -25,6 +29,10 @@ bool LpSolveOptions::IsValid(std::string* error) const {
     if (error) *error = "LP tolerances must lie in (0, 1e-3)";
     return false;
   }
+  if (std::isnan(objective_cutoff)) {
+    if (error) *error = "the LP objective cutoff must be a number (+inf: none)";
+    return false;
+  }
   if (!(time_limit_seconds > 0)) {
     if (error) *error = "the LP time limit must be positive";
     return false;
@@ -32,7 +40,7 @@ bool LpSolveOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::vector<std::string> AvailableLpSolvers() { return {"clp", "glpk"}; }
+std::vector<std::string> AvailableLpSolvers() { return {"clp", "glpk", "ipm"}; }
 
 bool ValidLpSolverName(const std::string& name, std::string* error) {
   const auto names = AvailableLpSolvers();
@@ -45,6 +53,8 @@ std::unique_ptr<LpSolver> MakeLpSolver(const std::string& name) {
   std::string error;
   if (!ValidLpSolverName(name, &error)) throw std::invalid_argument(error);
   if (name == "glpk") return std::make_unique<GlpkSolver>();
+  if (name == "ipm")
+    return std::make_unique<FallbackSolver>("ipm", std::make_unique<IpmSolver>(), std::make_unique<ClpSolver>());
   return std::make_unique<ClpSolver>();
 }
 

@@ -2,6 +2,7 @@
 // The interface every LP backend of the exact-set engine implements (CLP today; exact/clp_solver.hpp).
 // A backend solves in floating point and reports what it found; it proves nothing. Proofs come from
 // exact/safe_bound.hpp, which turns any dual vector into a rigorous bound.
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -10,13 +11,16 @@
 
 namespace hw::exact {
 
-enum class LpStatus { kOptimal, kInfeasible, kUnbounded, kIterationLimit, kFailed };
+// kCutoff: the solve stopped once its dual bound passed LpSolveOptions::objective_cutoff (the optimum lies above).
+enum class LpStatus { kOptimal, kCutoff, kInfeasible, kUnbounded, kIterationLimit, kFailed };
 std::string ToString(LpStatus status);
 
 struct LpSolveOptions {
   double primal_tolerance = 1e-9;  // tighter than CLP's default 1e-7: certificates need accurate duals
   double dual_tolerance = 1e-10;
   double time_limit_seconds = 600.0;
+  // A backend may stop as soon as it knows the optimum exceeds this (a pruning test needs no more); +inf = solve.
+  double objective_cutoff = std::numeric_limits<double>::infinity();
   bool IsValid(std::string* error) const;
 };
 
@@ -40,7 +44,8 @@ class LpSolver {
   virtual LpResult Solve(const LpProblem& problem, const LpBasis& warm, const LpSolveOptions& options) = 0;
 };
 
-// "clp" (dual simplex, COIN-OR CLP) or "glpk" (dual simplex, GNU GLPK).
+// "clp" (dual simplex, COIN-OR CLP), "glpk" (dual simplex, GNU GLPK) or "ipm" (interior point,
+// exact/ipm_solver.hpp, with CLP for the LPs it leaves unsolved: exact/fallback_solver.hpp).
 std::unique_ptr<LpSolver> MakeLpSolver(const std::string& name);
 std::vector<std::string> AvailableLpSolvers();
 bool ValidLpSolverName(const std::string& name, std::string* error);

@@ -18,6 +18,7 @@
 #include "core/csv_table.hpp"
 #include "dss/hw_outer_set.hpp"
 #include "exact/exact_bounds.hpp"
+#include "exact/lp_solver.hpp"
 #include "paper_examples/cerone/paper_table.hpp"
 
 namespace {
@@ -175,7 +176,8 @@ std::string Summary(const std::vector<std::string>& dirs) {
 int main(int argc, char** argv) {
   CLI::App app{"Exact-set intervals against the paper's Table I on a committed realisation"};
   std::string tables, out;
-  int threads = 2, lp_budget = exact::ObjectiveSearchOptions{}.lp_budget;
+  int threads = 2, lp_budget = exact::ObjectiveSearchOptions{}.lp_budget, sweeps = exact::ExactBoundsOptions{}.sweeps;
+  std::string lp_solver = exact::ExactBoundsOptions{}.lp_solver;
   std::vector<std::string> summarise;
   std::string summary_out;
   app.add_option("--tables", tables, "a committed cerone_tables result (tables.json) with an n = 2 case");
@@ -185,6 +187,11 @@ int main(int argc, char** argv) {
   app.add_option("--summary-out", summary_out, "with --summarise: the Markdown file to write");
   app.add_option("--threads", threads, "fork workers");
   app.add_option("--lp-budget", lp_budget, "LPs per endpoint refinement");
+  app.add_option("--sweeps", sweeps, "bounding sweeps")->check(CLI::PositiveNumber);
+  app.add_option("--lp-solver", lp_solver, "LP backend: clp, glpk or ipm")->check([](const std::string& name) {
+    std::string error;
+    return exact::ValidLpSolverName(name, &error) ? std::string() : error;
+  });
   CLI11_PARSE(app, argc, argv);
   try {
     if (!summarise.empty()) {
@@ -204,6 +211,8 @@ int main(int argc, char** argv) {
     exact::ExactBoundsOptions options;
     options.threads = threads;
     options.search.lp_budget = lp_budget;
+    options.sweeps = sweeps;
+    options.lp_solver = lp_solver;
     const auto s = exact::ComputeExactBounds(options, dss::CeroneExampleStructure(), data, one.box,
                                              [](const exact::ExactBoundsProgress& p) {
                                                fmt::print(stderr, "[{:.0f} s] {} {}/{} {}\n", p.elapsed_seconds, p.phase,
@@ -213,9 +222,10 @@ int main(int argc, char** argv) {
     std::string md = fmt::format(
         "# Exact set D, seed {}, N = {}, {} dB (realised {:.2f} dB), noise bound {:.6g}\n\n"
         "Start box: D^ss(2) at δ = {} from `{}` (stage 1: {:.0f} s wall in that committed run, which may have read "
-        "its jobs from a run cache). Command: `exact_tables --tables {} --out {} --threads {} --lp-budget {}`.\n\n",
+        "its jobs from a run cache). Command: `exact_tables --tables {} --out {} --threads {} --lp-budget {} --sweeps {} "
+        "--lp-solver {}`.\n\n",
         one.seed, one.samples, one.snr_db, ex.snr_db, ex.noise_bound, one.order, tables, one.seconds, tables, out,
-        threads, lp_budget);
+        threads, lp_budget, sweeps, lp_solver);
     md += Table(s, one, truth);
     md += fmt::format("\nStage 2: {:.1f} s wall on {} (prune {:.1f} s, inner hull {:.1f} s, bound {:.1f} s); {} "
                       "levels, {} boxes tested, {} pruned; {} LPs of {} x {} ({} nonzeros), {} not optimal. "

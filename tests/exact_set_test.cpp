@@ -199,7 +199,7 @@ std::vector<std::vector<double>> IndependentMembers(const LiftedData& d, const t
 
 // Soundness over many seeded random systems of several structures: the truth and every independently found
 // point of D lie in every interval.
-void CheckSoundness(uint64_t first_seed, int count) {
+void CheckSoundness(uint64_t first_seed, int count, const std::string& lp_solver = "clp") {
   int members_checked = 0;
   std::mt19937 rng(static_cast<unsigned>(first_seed));
   ClpSolver clp;
@@ -209,7 +209,9 @@ void CheckSoundness(uint64_t first_seed, int count) {
     const auto inst = testing::MakeRandomHwInstance(seed, opts);
     const LiftedData d = MakeLiftedData(inst.structure, inst.data);
     const ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
-    const ExactBoundsSummary s = ComputeExactBounds(SmallRunOptions(), inst.structure, inst.data, start);
+    ExactBoundsOptions options = SmallRunOptions();
+    options.lp_solver = lp_solver;
+    const ExactBoundsSummary s = ComputeExactBounds(options, inst.structure, inst.data, start);
     ASSERT_FALSE(s.invalidated) << inst.description;
     for (const auto& p : IndependentMembers(d, inst, start, clp, rng)) {
       ++members_checked;
@@ -226,6 +228,9 @@ TEST(ExactSoundness, RandomSystemsSeeds1To25) { CheckSoundness(1, 25); }
 TEST(ExactSoundness, RandomSystemsSeeds26To50) { CheckSoundness(26, 25); }
 TEST(ExactSoundness, RandomSystemsSeeds51To75) { CheckSoundness(51, 25); }
 TEST(ExactSoundness, RandomSystemsSeeds76To100) { CheckSoundness(76, 25); }
+// The interior-point backend on other systems (its duals, not a simplex's, certify every prune and bound).
+TEST(ExactSoundness, RandomSystemsSeeds101To125InteriorPoint) { CheckSoundness(101, 25, "ipm"); }
+TEST(ExactSoundness, RandomSystemsSeeds126To150InteriorPoint) { CheckSoundness(126, 25, "ipm"); }
 
 TEST(ExactBounds, NarrowerThanTheStartBoxAndTheSameOnEveryExecutor) {
   const auto inst = InstanceOf(5, 80);
