@@ -13,7 +13,7 @@ void AddCompareCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "compare",
       "Comparison study: every method on the same plant and noise level with its own experiment, R seeded runs "
-      "in parallel worker processes; writes DIR/summary.md, summary.json, runs/*.json and plots");
+      "in parallel worker processes; writes DIR/summary.md, summary.json, runs/<study key>/jobs/*.json and plots");
   struct Opts {
     std::string scenario, out;
     std::vector<std::string> methods = {"setmembership", "brouri", "esmaeilani"}, params;

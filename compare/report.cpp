@@ -121,7 +121,8 @@ std::string SummaryMarkdown(const json& s) {
   if (s["methods"].contains("setmembership") && s["methods"]["setmembership"].contains("quantities"))
     md += fmt::format("\n{}\n", kMidpointNote);
   if (!s.value("coverage_ok", true))
-    md += "\n**COVERAGE FAILURE: a guaranteed interval excluded the truth (see runs/*.json).**\n";
+    md += fmt::format("\n**COVERAGE FAILURE: a guaranteed interval excluded the truth (see {}/*.json).**\n",
+                      s.value("run_files", "runs"));
   if (s.contains("plots_note") && !s["plots_note"].get<std::string>().empty())
     md += "\nPlots: " + s["plots_note"].get<std::string>() + "\n";
   return md;

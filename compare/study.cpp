@@ -5,7 +5,6 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -13,7 +12,7 @@
 #include "compare/methods.hpp"
 #include "core/atomic_write.hpp"
 #include "core/input_error.hpp"
-#include "core/json_input.hpp"
+#include "dss/run_cache.hpp"
 #include "sdp/job_executor.hpp"
 
 namespace hw::compare {
@@ -22,19 +21,13 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-std::string RunPath(const std::string& dir, int r) { return fmt::format("{}/runs/run_{:04d}.json", dir, r); }
+// A run's name in the run cache (its file: DIR/runs/<study key>/jobs/run_NNNN.json).
+std::string RunName(int r) { return fmt::format("run_{:04d}", r); }
 
-std::string StudyKey(const Scenario& s, const StudyOptions& o) {
-  const std::string text = s.to_json().dump() + "|" + fmt::format("{}", fmt::join(o.methods, ",")) + "|" +
-                           std::to_string(o.seed);
-  return fmt::format("{:016x}", std::hash<std::string>{}(text));
-}
-
-// A run's result file when it is there, readable and of this study (a study resumes from those).
-std::optional<json> ReadRunOfStudy(const std::string& dir, int r, const std::string& key) {
-  auto j = ReadStoredJson(RunPath(dir, r));
-  if (!j || j->value("study_key", "") != key) return std::nullopt;
-  return j;
+// What a study's runs depend on (scenario + methods + seed): its hash names the run cache's folder, so a rerun of
+// the same study resumes from the files there and a different study never reads them.
+json StudyInputs(const Scenario& s, const StudyOptions& o) {
+  return {{"scenario", s.to_json()}, {"methods", o.methods}, {"seed", o.seed}};
 }
 
 // Lower is better for errors, higher for the fit.
@@ -173,15 +166,21 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   if (!options.IsValid(&err)) throw InputError(err);
   if (!scenario.IsValid(&err)) throw InputError("scenario " + scenario.name + ": " + err);
   const auto t0 = std::chrono::steady_clock::now();
-  fs::create_directories(fs::path(options.out_dir) / "runs");
+  fs::create_directories(options.out_dir);
   write_text_atomic(options.out_dir + "/scenario.json", scenario.to_json().dump(2) + "\n");
-  const std::string key = StudyKey(scenario, options);
+  const json inputs = StudyInputs(scenario, options);
+  const std::string key = dss::TextHash(inputs.dump());
+  // The shared run cache (dss/run_cache.hpp): finished runs on disk, written atomically, damaged files recomputed.
+  const dss::RunCache cache((fs::path(options.out_dir) / "runs").string(), key, inputs);
   StudySummary result;
   std::vector<int> pending;
+  std::vector<std::string> names;
   for (int r = 0; r < options.runs; ++r) {
-    if (ReadRunOfStudy(options.out_dir, r, key)) ++result.runs_resumed;
+    names.push_back(RunName(r));
+    if (cache.load(names.back())) ++result.runs_resumed;
     else pending.push_back(r);
   }
+  cache.plan(names);
   int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   jobs = std::min<int>(jobs, std::max<std::size_t>(1, pending.size()));
   if (!options.quiet)
@@ -194,9 +193,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
     std::vector<std::string> specs;
     for (int r : pending) specs.push_back(std::to_string(r));
     const sdp::JobFunction run = [&](const std::string& spec) {
-      json j = RunOne(scenario, options.methods, std::stoi(spec), options.seed);
-      j["study_key"] = key;
-      return j.dump();
+      return RunOne(scenario, options.methods, std::stoi(spec), options.seed).dump();
     };
     sdp::ForkExecutor executor(jobs);
     executor.Map(specs, run, [&](std::size_t i, const sdp::JobResult& answer) {
@@ -206,7 +203,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
         return;
       }
       const json j = json::parse(answer.text);
-      write_text_atomic(RunPath(options.out_dir, r), j.dump(1) + "\n");
+      cache.store(RunName(r), j);
       if (options.quiet) return;
       std::string line = fmt::format("  run {:3d}:", r);
       for (const auto& [name, m] : j["methods"].items())
@@ -219,7 +216,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   std::vector<json> runs;
   std::vector<int> missing;
   for (int r = 0; r < options.runs; ++r) {
-    if (auto j = ReadRunOfStudy(options.out_dir, r, key)) runs.push_back(std::move(*j));
+    if (auto j = cache.load(RunName(r))) runs.push_back(std::move(*j));
     else missing.push_back(r);
   }
   if (!missing.empty())
@@ -235,6 +232,7 @@ StudySummary RunStudy(const StudyOptions& options, const Scenario& scenario) {
   result.summary["runs_computed"] = result.runs_computed;
   result.summary["runs_resumed"] = result.runs_resumed;
   result.summary["study_key"] = key;
+  result.summary["run_files"] = fs::relative(fs::path(cache.path()) / "jobs", options.out_dir).generic_string();
   result.coverage_ok = result.summary["coverage_ok"];
   result.all_ok = result.summary["all_ok"];
   if (options.plots) result.summary["plots_note"] = WritePlots(options.out_dir, scenario, runs, result.summary);

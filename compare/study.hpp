@@ -2,9 +2,11 @@
 // A comparison study: R seeded Monte Carlo runs of every selected method on one scenario.
 //
 // Parallelism is process-level: CSDP and SDPA keep process-wide state, so `jobs` forked worker processes
-// each run whole runs (all methods of a run, set-membership SDPs solved in-process) and write the run's JSON
-// atomically to DIR/runs/run_NNNN.json; the parent only aggregates. A run whose file exists with the same
-// study key (scenario + methods + seed) is not recomputed, so an interrupted study resumes.
+// each run whole runs (all methods of a run, set-membership SDPs solved in-process) on the shared executor
+// (sdp::ForkExecutor); the parent stores each run's JSON in the shared run cache (dss::RunCache, written
+// atomically) as DIR/runs/<study key>/jobs/run_NNNN.json, the key being the hash of the study's inputs (scenario +
+// methods + seed, DIR/runs/<study key>/problem.json). A run whose file is there is not recomputed, so an
+// interrupted study resumes; a damaged file is recomputed.
 // The summary is computed from the per-run files alone (never from in-memory results), so the tables
 // always agree with the files they summarise.
 #include <cstdint>

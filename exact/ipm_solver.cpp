@@ -15,6 +15,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxIterations = 60;
 constexpr int kStallIterations = 10;
+constexpr int kCentralityCorrectors = 2;  // Gondzio's, each one more solve with the same factor
 constexpr double kStepFraction = 0.995;  // of the way to the boundary
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
@@ -349,49 +350,81 @@ class InteriorPoint {
     return count ? sum / count : 0.0;
   }
 
-  // Solves the Newton system for the complementarity targets: s * z + (ds * dz) = target - correction.
-  // `affine` (may be null) holds the predictor direction whose second-order term the corrector removes.
-  Direction Solve(double target, const Direction* affine) {
+  // The wanted change of every product s * z of a bound pair (columns' lower and upper, rows' lower and upper).
+  struct Complementarity {
+    Vector l, u, rl, ru;
+  };
+
+  // Mehrotra's right-hand side: towards `target`, less the predictor's second-order term when given.
+  Complementarity MehrotraRhs(double target, const Direction* affine) const {
     const int n = f_.n, m = f_.m;
-    Vector sl = it_.x - f_.col_lo, su = f_.col_hi - it_.x;
-    Vector rcl(n), rcu(n), fx(n);
+    Complementarity rc{Vector(n), Vector(n), Vector::Zero(m), Vector::Zero(m)};
     for (int j = 0; j < n; ++j) {
-      rcl[j] = target - sl[j] * it_.zl[j] - (affine ? affine->dx[j] * affine->dzl[j] : 0.0);
-      rcu[j] = target - su[j] * it_.zu[j] + (affine ? affine->dx[j] * affine->dzu[j] : 0.0);
-      fx[j] = -rd_x_[j] + rcl[j] / sl[j] - rcu[j] / su[j];
+      rc.l[j] = target - (it_.x[j] - f_.col_lo[j]) * it_.zl[j] - (affine ? affine->dx[j] * affine->dzl[j] : 0.0);
+      rc.u[j] = target - (f_.col_hi[j] - it_.x[j]) * it_.zu[j] + (affine ? affine->dx[j] * affine->dzu[j] : 0.0);
     }
-    Vector rcrl = Vector::Zero(m), rcru = Vector::Zero(m), fr = Vector::Zero(m), rhs_r(m);
+    for (int i = 0; i < m; ++i) {
+      if (f_.equality[i]) continue;
+      if (Finite(f_.row_lo[i]))
+        rc.rl[i] = target - (it_.r[i] - f_.row_lo[i]) * it_.zrl[i] - (affine ? affine->dr[i] * affine->dzrl[i] : 0.0);
+      if (Finite(f_.row_hi[i]))
+        rc.ru[i] = target - (f_.row_hi[i] - it_.r[i]) * it_.zru[i] + (affine ? affine->dr[i] * affine->dzru[i] : 0.0);
+    }
+    return rc;
+  }
+
+  // Gondzio's centrality corrector: the products a longer step along `d` would reach, pulled back into
+  // [0.1, 10] x target, added to `base`. Stalls come from a few products far below the others.
+  Complementarity GondzioRhs(const Complementarity& base, const Direction& d, double ap, double ad, double target) const {
+    const double ap_t = std::min(1.0, 1.5 * ap + 0.1), ad_t = std::min(1.0, 1.5 * ad + 0.1);
+    const double lo = 0.1 * target, hi = 10.0 * target;
+    auto correction = [&](double s, double ds, double z, double dz) {
+      const double v = (s + ap_t * ds) * (z + ad_t * dz);
+      return std::max(std::clamp(v, lo, hi) - v, -hi);
+    };
+    Complementarity rc = base;
+    for (int j = 0; j < f_.n; ++j) {
+      rc.l[j] += correction(it_.x[j] - f_.col_lo[j], d.dx[j], it_.zl[j], d.dzl[j]);
+      rc.u[j] += correction(f_.col_hi[j] - it_.x[j], -d.dx[j], it_.zu[j], d.dzu[j]);
+    }
+    for (int i = 0; i < f_.m; ++i) {
+      if (f_.equality[i]) continue;
+      if (Finite(f_.row_lo[i])) rc.rl[i] += correction(it_.r[i] - f_.row_lo[i], d.dr[i], it_.zrl[i], d.dzrl[i]);
+      if (Finite(f_.row_hi[i])) rc.ru[i] += correction(f_.row_hi[i] - it_.r[i], -d.dr[i], it_.zru[i], d.dzru[i]);
+    }
+    return rc;
+  }
+
+  // Solves the Newton system for the wanted complementarity changes `rc`.
+  Direction Solve(const Complementarity& rc) {
+    const int n = f_.n, m = f_.m;
+    const Vector sl = it_.x - f_.col_lo, su = f_.col_hi - it_.x;
+    Vector fx(n);
+    for (int j = 0; j < n; ++j) fx[j] = -rd_x_[j] + rc.l[j] / sl[j] - rc.u[j] / su[j];
+    Vector rhs_r(m);
     for (int i = 0; i < m; ++i) {
       if (f_.equality[i]) {
         rhs_r[i] = rp_[i];
         continue;
       }
-      fr[i] = -rd_r_[i];
-      if (Finite(f_.row_lo[i])) {
-        const double s = it_.r[i] - f_.row_lo[i];
-        rcrl[i] = target - s * it_.zrl[i] - (affine ? affine->dr[i] * affine->dzrl[i] : 0.0);
-        fr[i] += rcrl[i] / s;
-      }
-      if (Finite(f_.row_hi[i])) {
-        const double s = f_.row_hi[i] - it_.r[i];
-        rcru[i] = target - s * it_.zru[i] + (affine ? affine->dr[i] * affine->dzru[i] : 0.0);
-        fr[i] -= rcru[i] / s;
-      }
-      rhs_r[i] = rp_[i] - d_r_[i] * fr[i];
+      double fr = -rd_r_[i];
+      if (Finite(f_.row_lo[i])) fr += rc.rl[i] / (it_.r[i] - f_.row_lo[i]);
+      if (Finite(f_.row_hi[i])) fr -= rc.ru[i] / (f_.row_hi[i] - it_.r[i]);
+      rhs_r[i] = rp_[i] - d_r_[i] * fr;
     }
     Direction d;
     system_.Solve(fx, rhs_r, &d.dx, &d.dy);
     d.dr = f_.A * d.dx + rp_;
     for (int i = 0; i < m; ++i)
       if (f_.equality[i]) d.dr[i] = 0.0;
-    d.dzl = (rcl - it_.zl.cwiseProduct(d.dx)).cwiseQuotient(sl);
-    d.dzu = (rcu + it_.zu.cwiseProduct(d.dx)).cwiseQuotient(su);
+    d.dzl = (rc.l - it_.zl.cwiseProduct(d.dx)).cwiseQuotient(sl);
+    d.dzu = (rc.u + it_.zu.cwiseProduct(d.dx)).cwiseQuotient(su);
     d.dzrl = Vector::Zero(m);
     d.dzru = Vector::Zero(m);
     for (int i = 0; i < m; ++i) {
       if (f_.equality[i]) continue;
-      if (Finite(f_.row_lo[i])) d.dzrl[i] = (rcrl[i] - it_.zrl[i] * d.dr[i]) / (it_.r[i] - f_.row_lo[i]);
-      if (Finite(f_.row_hi[i])) d.dzru[i] = (rcru[i] + it_.zru[i] * d.dr[i]) / (f_.row_hi[i] - it_.r[i]);
+      if (Finite(f_.row_lo[i])) d.dzrl[i] = (rc.rl[i] - it_.zrl[i] * d.dr[i]) / (it_.r[i] - f_.row_lo[i]);
+      if (Finite(f_.row_hi[i])) d.dzru[i] = (rc.ru[i] + it_.zru[i] * d.dr[i]) / (f_.row_hi[i] - it_.r[i]);
     }
     return d;
   }
@@ -451,12 +484,20 @@ class InteriorPoint {
     for (double reg = 1e-10; reg <= 1e-4 && !factored; reg *= 100) factored = system_.Factorize(h_x, d_r_, reg);
     if (!factored) return false;
     const double mu = Mu();
-    const Direction affine = Solve(0.0, nullptr);
+    const Direction affine = Solve(MehrotraRhs(0.0, nullptr));
     const auto [ap_aff, ad_aff] = StepLengths(affine);
     const double mu_aff = MuAfter(affine, ap_aff, ad_aff);
     const double sigma = std::pow(std::clamp(mu_aff / mu, 0.0, 1.0), 3);
-    const Direction d = Solve(sigma * mu, &affine);
+    Complementarity rc = MehrotraRhs(sigma * mu, &affine);
+    Direction d = Solve(rc);
     auto [ap, ad] = StepLengths(d);
+    for (int k = 0; k < kCentralityCorrectors; ++k) {
+      const Complementarity rc_k = GondzioRhs(rc, d, ap, ad, sigma * mu);
+      Direction d_k = Solve(rc_k);
+      const auto [ap_k, ad_k] = StepLengths(d_k);
+      if (std::min(ap_k, ad_k) < 1.01 * std::min(ap, ad)) break;  // no longer steps: keep the last direction
+      rc = rc_k, d = std::move(d_k), ap = ap_k, ad = ad_k;
+    }
     ap = std::min(1.0, kStepFraction * ap);
     ad = std::min(1.0, kStepFraction * ad);
     if (!(ap > 0) || !(ad > 0) || !d.dx.allFinite() || !d.dy.allFinite()) return false;

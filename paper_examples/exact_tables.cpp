@@ -7,6 +7,7 @@
 //   exact_tables --tables paper_examples/results/cerone_n23_snr31_delta3/tables.json --out DIR [--threads 2]
 //   exact_tables --summarise DIR1 DIR2 ... --summary-out FILE.md   (one table over earlier runs)
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include <CLI/CLI.hpp>
@@ -202,6 +203,10 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (tables.empty() || out.empty()) throw InputError("--tables and --out are required (or --summarise DIR...)");
+    // Made before the run, so a folder that cannot be made fails now, not after stage 2.
+    std::error_code made;
+    std::filesystem::create_directories(out, made);
+    if (made) throw InputError(fmt::format("{}: cannot make the output folder ({})", out, made.message()));
     const StageOne one = ReadStageOne(tables);
     const CeroneExample ex = SimulateCeroneExample(one.seed, one.samples, one.snr_db);
     dss::HwData data;

@@ -141,6 +141,12 @@ std::map<std::string, std::vector<double>> Values(const std::vector<json>& runs,
   return v;
 }
 
+// Run k's file in the study's run cache (summary.json names the folder: runs/<study key>/jobs).
+std::string RunFile(const StudyOptions& o, const json& summary, int k) {
+  EXPECT_EQ(summary["run_files"], "runs/" + summary["study_key"].get<std::string>() + "/jobs");
+  return fmt::format("{}/{}/run_{:04d}.json", o.out_dir, summary["run_files"].get<std::string>(), k);
+}
+
 // The set-membership example made small: n = 1, delta = 1 on 40 samples, seconds per run (the scenario's own
 // n = 2, delta = 2: minutes).
 Scenario SmallSetMembershipExample() {
@@ -174,7 +180,7 @@ TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth
     EXPECT_TRUE(fs::exists(o.out_dir + "/" + f)) << f;
   const json summary = ReadJson(o.out_dir + "/summary.json");
   std::vector<json> runs;
-  for (int k = 0; k < o.runs; ++k) runs.push_back(ReadJson(fmt::format("{}/runs/run_{:04d}.json", o.out_dir, k)));
+  for (int k = 0; k < o.runs; ++k) runs.push_back(ReadJson(RunFile(o, summary, k)));
 
   // Every applicable method ran in every run; brouri was reported, not run.
   EXPECT_TRUE(summary["all_ok"].get<bool>()) << summary["methods"].dump(1);
@@ -241,6 +247,15 @@ TEST(CompareStudy, SmallStudyTablesAgreeWithPerRunFilesAndIntervalsCoverTheTruth
   EXPECT_EQ(r2.runs_computed, 0);
   EXPECT_EQ(r2.runs_resumed, 3);
   EXPECT_EQ(r2.summary["methods"].dump(), summary["methods"].dump());
+
+  // A damaged run file is recomputed, never trusted; the other runs resume.
+  { std::ofstream(RunFile(o, summary, 1)) << "{\"methods\": "; }
+  const auto r3 = RunStudy(o, s);
+  EXPECT_EQ(r3.runs_computed, 1);
+  EXPECT_EQ(r3.runs_resumed, 2);
+  EXPECT_TRUE(r3.coverage_ok);
+  EXPECT_EQ(ReadJson(RunFile(o, summary, 1))["methods"]["setmembership"]["intervals"].dump(),
+            runs[1]["methods"]["setmembership"]["intervals"].dump());
 }
 
 TEST(CompareStudy, TheExactSetIsAMethodInsideTheOuterSetAndAroundTheTruth) {
@@ -250,8 +265,9 @@ TEST(CompareStudy, TheExactSetIsAMethodInsideTheOuterSetAndAroundTheTruth) {
   const auto r = RunStudy(o, s);
   EXPECT_TRUE(r.coverage_ok);
   const auto truth = CeroneExample::TrueParameters();
+  const json summary = ReadJson(o.out_dir + "/summary.json");
   for (int k = 0; k < o.runs; ++k) {
-    const json run = ReadJson(fmt::format("{}/runs/run_{:04d}.json", o.out_dir, k));
+    const json run = ReadJson(RunFile(o, summary, k));
     const auto& outer = run["methods"]["setmembership"];
     const auto& ex = run["methods"]["exact"];
     ASSERT_EQ(ex["status"], "ok") << ex.dump(1);
@@ -274,7 +290,6 @@ TEST(CompareStudy, TheExactSetIsAMethodInsideTheOuterSetAndAroundTheTruth) {
     }
     EXPECT_LT(exact_width, outer_width) << "the exact set is smaller than D^ss(n)";
   }
-  const json summary = ReadJson(o.out_dir + "/summary.json");
   EXPECT_EQ(summary["methods"]["exact"]["coverage"]["covered"].get<int>(), o.runs * static_cast<int>(truth.size()));
   std::ifstream md_in(o.out_dir + "/summary.md");
   std::stringstream md;

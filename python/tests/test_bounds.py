@@ -163,16 +163,25 @@ def test_ctrl_c_stops_a_long_run_promptly_and_cleanly():
 
 
 def test_moment_witnesses_switch_as_in_the_cli(recording, tmp_path):
+    # The relaxations are solved once, by the first CLI run into a run directory. The switch is not part of the run
+    # cache's key, so the later runs read them back (any other setting that differed would solve them again, and
+    # sdp_jobs would say so) and run only the work after them: the switch's stage.
     path, rec = recording
-    run_cli("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 2, "--params", "a1",
-            "--solver", "csdp", "--threads", 2, "--no-moment-witnesses", "--quiet", "--json", tmp_path / "cli.json")
-    cli = load_json(tmp_path / "cli.json")
+    run_dir = tmp_path / "run"
+    args = ("bounds", "--data", path, "--noise-col", "noise_bound", "--horizon", 1, "--order", 2, "--params", "a1",
+            "--solver", "csdp", "--threads", 2, "--no-moment-witnesses", "--quiet", "--run-dir", run_dir)
+    run_cli(*args, "--json", tmp_path / "solved.json")
+    run_cli(*args, "--json", tmp_path / "cli.json")
+    solved, cli = load_json(tmp_path / "solved.json"), load_json(tmp_path / "cli.json")
     off = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=2, parameters=["a1"],
-                          solver="csdp", threads=2, moment_witnesses=False, source=path)
+                          solver="csdp", threads=2, moment_witnesses=False, source=path, run_dir=str(run_dir))
     on = hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, order=2, parameters=["a1"],
-                         solver="csdp", threads=2, source=path)
+                         solver="csdp", threads=2, source=path, run_dir=str(run_dir))
     assert without(off, "timing") == without(cli, "timing")
-    assert off["counts"]["moment_witness_jobs"] == 0
+    assert solved["counts"]["sdp_jobs"] > 0
+    assert cli["counts"]["sdp_jobs"] == off["counts"]["sdp_jobs"] == on["counts"]["sdp_jobs"] == 0
+    assert without(cli, "timing", "counts") == without(solved, "timing", "counts")  # read back as solved
+    assert solved["counts"]["moment_witness_jobs"] == off["counts"]["moment_witness_jobs"] == 0
     assert on["counts"]["moment_witness_jobs"] > 0
     # The stage adds feasible points only: the bounds stay.
     for a, b in zip(on["intervals"], off["intervals"]):
