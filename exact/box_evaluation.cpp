@@ -13,6 +13,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// A bounding LP may stop once its objective is within this fraction of the box's width in the parameter of its
+// dual bound: the bound loses at most that much of the box it bounds.
+constexpr double kAcceptableGapOfWidth = 1e-3;
+
 // Ended with an answer: optimal, or stopped at the objective cutoff.
 bool Solved(LpStatus status) { return status == LpStatus::kOptimal || status == LpStatus::kCutoff; }
 
@@ -161,7 +165,9 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     std::vector<double> weights(lay.count(), 0.0);
     weights[objective.parameter] = sign;
     lifted.SetParameterObjective(weights);
-    BoundSolve s = SolveBound(lifted, solver, warm, options.lp);
+    LpSolveOptions lp = options.lp;
+    lp.acceptable_gap = kAcceptableGapOfWidth * (box[objective.parameter].hi - box[objective.parameter].lo);
+    BoundSolve s = SolveBound(lifted, solver, warm, lp);
     ++out.lps;
     if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
     if (!Usable(s)) return failed_lp();
@@ -179,10 +185,12 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     double g = box[objective.parameter].mid();
     LpBasis basis = warm;
     std::optional<double> best;
+    LpSolveOptions lp = options.lp;  // a gap m in the objective moves the gamma bound by m / |b|
+    lp.acceptable_gap = kAcceptableGapOfWidth * (box[objective.parameter].hi - box[objective.parameter].lo) * b_near;
     for (int step = 0; step < 8; ++step) {
       lifted.SetRatioObjective(ratio_j, k, g);
       for (double& c : lifted.lp.obj) c *= sigma * sign;
-      BoundSolve s = SolveBound(lifted, solver, basis, options.lp);
+      BoundSolve s = SolveBound(lifted, solver, basis, lp);
       ++out.lps;
       if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
       if (!Usable(s)) {

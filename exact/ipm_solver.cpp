@@ -260,12 +260,13 @@ class InteriorPoint {
 
   // The status of a solve that stops short. Its dual bound far above the objective of an infeasible iterate:
   // the dual was diverging, the sign of an infeasible LP (the caller proves emptiness on its own). Feasible and
-  // within kStalledGapTolerance of its dual bound: optimal to that tolerance.
+  // within kStalledGapTolerance (or the caller's acceptable gap) of its dual bound: optimal to that tolerance.
   LpStatus Stopped(LpStatus status, double pobj) const {
     const double scale = 1.0 + std::abs(pobj);
     const bool feasible = primal_infeasibility_ <= options_.primal_tolerance;
     if (!feasible && best_dual_ > pobj + 1e-3 * scale) return LpStatus::kInfeasible;
-    if (feasible && pobj - best_dual_ <= kStalledGapTolerance * scale) return LpStatus::kOptimal;
+    if (feasible && pobj - best_dual_ <= std::max(kStalledGapTolerance * scale, options_.acceptable_gap))
+      return LpStatus::kOptimal;
     return status;
   }
 

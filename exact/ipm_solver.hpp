@@ -13,7 +13,7 @@ namespace hw::exact {
 
 class IpmSolver : public LpSolver {
  public:
-  std::string name() const override { return "ipm"; }
+  std::string name() const override { return "ipm-only"; }
   // `warm` is ignored (no basis). Stops when optimal to the options' tolerances, or, with an objective cutoff,
   // as soon as its dual bound exceeds the cutoff (status kCutoff).
   LpResult Solve(const LpProblem& problem, const LpBasis& warm, const LpSolveOptions& options) override;

@@ -29,6 +29,10 @@ bool LpSolveOptions::IsValid(std::string* error) const {
     if (error) *error = "LP tolerances must lie in (0, 1e-3)";
     return false;
   }
+  if (!(acceptable_gap >= 0.0)) {
+    if (error) *error = "the LP's acceptable gap must be >= 0";
+    return false;
+  }
   if (std::isnan(objective_cutoff)) {
     if (error) *error = "the LP objective cutoff must be a number (+inf: none)";
     return false;
@@ -40,7 +44,7 @@ bool LpSolveOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::vector<std::string> AvailableLpSolvers() { return {"clp", "glpk", "ipm"}; }
+std::vector<std::string> AvailableLpSolvers() { return {"clp", "glpk", "ipm", "ipm-only"}; }
 
 bool ValidLpSolverName(const std::string& name, std::string* error) {
   const auto names = AvailableLpSolvers();
@@ -53,6 +57,7 @@ std::unique_ptr<LpSolver> MakeLpSolver(const std::string& name) {
   std::string error;
   if (!ValidLpSolverName(name, &error)) throw std::invalid_argument(error);
   if (name == "glpk") return std::make_unique<GlpkSolver>();
+  if (name == "ipm-only") return std::make_unique<IpmSolver>();
   if (name == "ipm")
     return std::make_unique<FallbackSolver>("ipm", std::make_unique<IpmSolver>(), std::make_unique<ClpSolver>());
   return std::make_unique<ClpSolver>();

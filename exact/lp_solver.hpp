@@ -21,6 +21,9 @@ struct LpSolveOptions {
   double time_limit_seconds = 600.0;
   // A backend may stop as soon as it knows the optimum exceeds this (a pruning test needs no more); +inf = solve.
   double objective_cutoff = std::numeric_limits<double>::infinity();
+  // The caller's accuracy need: a solve that stops short with its objective within this of its dual bound may
+  // report optimal (the dual bound, not the objective, is what gets certified). 0 = the backend's tolerance.
+  double acceptable_gap = 0.0;
   bool IsValid(std::string* error) const;
 };
 
@@ -44,8 +47,9 @@ class LpSolver {
   virtual LpResult Solve(const LpProblem& problem, const LpBasis& warm, const LpSolveOptions& options) = 0;
 };
 
-// "clp" (dual simplex, COIN-OR CLP), "glpk" (dual simplex, GNU GLPK) or "ipm" (interior point,
-// exact/ipm_solver.hpp, with CLP for the LPs it leaves unsolved: exact/fallback_solver.hpp).
+// "clp" (dual simplex, COIN-OR CLP), "glpk" (dual simplex, GNU GLPK), "ipm" (interior point,
+// exact/ipm_solver.hpp, with CLP for the LPs it leaves unsolved: exact/fallback_solver.hpp) or "ipm-only" (the
+// interior point alone: an LP it leaves unsolved gives its best dual bound, looser, never wrong).
 std::unique_ptr<LpSolver> MakeLpSolver(const std::string& name);
 std::vector<std::string> AvailableLpSolvers();
 bool ValidLpSolverName(const std::string& name, std::string* error);
