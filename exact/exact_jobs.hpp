@@ -13,7 +13,7 @@
 namespace hw::exact {
 
 struct ExactJobSettings {
-  std::string lp_solver = "clp";
+  std::string lp_solver = "ipm";
   BoxEvaluationOptions evaluation;
   ObjectiveSearchOptions search;
 };
