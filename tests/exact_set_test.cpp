@@ -16,6 +16,7 @@
 #include "exact/membership.hpp"
 #include "exact/safe_bound.hpp"
 #include "random_hw.hpp"
+#include "small_lps.hpp"
 #include "test_support.hpp"
 
 namespace hw::exact {
@@ -51,12 +52,7 @@ ExactBoundsOptions SmallRunOptions() {
 }
 
 TEST(SafeBound, EqualsTheLpOptimumOnASmallProblemAndNeverExceedsIt) {
-  // min x + y  s.t.  x + 2y >= 2, 3x + y >= 3, 0 <= x, y <= 10: optimum 1.4 at (0.8, 0.6).
-  LpProblem lp;
-  const int x = lp.AddColumn(0, 10), y = lp.AddColumn(0, 10);
-  lp.obj = {1.0, 1.0};
-  const int r1 = lp.AddRow(2, INFINITY), r2 = lp.AddRow(3, INFINITY);
-  lp.AddEntry(r1, x, 1), lp.AddEntry(r1, y, 2), lp.AddEntry(r2, x, 3), lp.AddEntry(r2, y, 1);
+  LpProblem lp = testing_lps::TwoRowLp();  // optimum 1.4
   ClpSolver clp;
   const LpResult r = clp.Solve(lp, {}, {});
   ASSERT_EQ(r.status, LpStatus::kOptimal);

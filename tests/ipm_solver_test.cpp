@@ -11,6 +11,7 @@
 #include "exact/ipm_solver.hpp"
 #include "exact/safe_bound.hpp"
 #include "random_hw.hpp"
+#include "small_lps.hpp"
 
 namespace hw::exact {
 namespace {
@@ -18,12 +19,8 @@ namespace {
 constexpr double kInf = INFINITY;
 
 TEST(IpmSolver, SolvesASmallLpAndItsDualsCertifyTheOptimum) {
-  // min x + y  s.t.  x + 2y >= 2, 3x + y >= 3, 0 <= x, y <= 10: optimum 1.4 at (0.8, 0.6).
-  LpProblem lp;
-  const int x = lp.AddColumn(0, 10), y = lp.AddColumn(0, 10);
-  lp.obj = {1.0, 1.0};
-  const int r1 = lp.AddRow(2, kInf), r2 = lp.AddRow(3, kInf);
-  lp.AddEntry(r1, x, 1), lp.AddEntry(r1, y, 2), lp.AddEntry(r2, x, 3), lp.AddEntry(r2, y, 1);
+  const LpProblem lp = testing_lps::TwoRowLp();  // optimum 1.4 at (0.8, 0.6)
+  const int x = 0, y = 1;
   IpmSolver ipm;
   const LpResult r = ipm.Solve(lp, {}, {});
   ASSERT_EQ(r.status, LpStatus::kOptimal) << r.message;
