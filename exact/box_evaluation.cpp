@@ -13,9 +13,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A bounding LP may stop once its objective is within this fraction of the box's width in the parameter of its
-// dual bound: the bound loses at most that much of the box it bounds.
-constexpr double kAcceptableGapOfWidth = 1e-3;
+// How close to its dual bound a bounding LP must come, in the parameter's units: the caller's need when it set
+// one (the branch and bound: a share of the gap it stops at), else this fraction of the box's width in the
+// parameter. The certified bound loses at most that much.
+constexpr double kAcceptableGapOfWidth = 1e-5;
+double AcceptableGap(const LpSolveOptions& lp, const Interval& range) {
+  return lp.acceptable_gap > 0 ? lp.acceptable_gap : kAcceptableGapOfWidth * (range.hi - range.lo);
+}
 
 // Ended with an answer: optimal, or stopped at the objective cutoff.
 bool Solved(LpStatus status) { return status == LpStatus::kOptimal || status == LpStatus::kCutoff; }
@@ -166,7 +170,7 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     weights[objective.parameter] = sign;
     lifted.SetParameterObjective(weights);
     LpSolveOptions lp = options.lp;
-    lp.acceptable_gap = kAcceptableGapOfWidth * (box[objective.parameter].hi - box[objective.parameter].lo);
+    lp.acceptable_gap = AcceptableGap(options.lp, box[objective.parameter]);
     BoundSolve s = SolveBound(lifted, solver, warm, lp);
     ++out.lps;
     if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
@@ -186,7 +190,7 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     LpBasis basis = warm;
     std::optional<double> best;
     LpSolveOptions lp = options.lp;  // a gap m in the objective moves the gamma bound by m / |b|
-    lp.acceptable_gap = kAcceptableGapOfWidth * (box[objective.parameter].hi - box[objective.parameter].lo) * b_near;
+    lp.acceptable_gap = AcceptableGap(options.lp, box[objective.parameter]) * b_near;
     for (int step = 0; step < 8; ++step) {
       lifted.SetRatioObjective(ratio_j, k, g);
       for (double& c : lifted.lp.obj) c *= sigma * sign;

@@ -120,6 +120,9 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
   const int p = objective.parameter;
   std::vector<SearchBox> live;
   for (const auto& b : boxes) live.push_back({b, objective.maximise ? -b[p].hi : b[p].lo});
+  // An LP bound within a hundredth of the stopping gap is as good as the exact optimum for this search.
+  BoxEvaluationOptions accuracy = evaluation;
+  if (target && target_gap > 0) accuracy.lp.acceptable_gap = 0.01 * target_gap;
   ObjectiveSearchResult out;
   while (!live.empty()) {
     // The box holding the worst bound (the first of equals: deterministic).
@@ -129,7 +132,7 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
     SearchBox& box = live[w];
     if (!box.evaluated) {
       if (out.lps >= options.lp_budget) break;
-      BoxEvaluation e = BoundObjective(data, box.box, objective, evaluation, solver, box.basis);
+      BoxEvaluation e = BoundObjective(data, box.box, objective, accuracy, solver, box.basis);
       out.lps += e.lps;
       out.lp_failures += e.lp_failures;
       if (e.verdict == BoxVerdict::kPruned) {
