@@ -19,6 +19,12 @@
 #include "sdp/job_executor.hpp"
 
 namespace hw::compare {
+
+std::string ToString(MethodStatus status) { return status == MethodStatus::kOk ? "ok" : "failed"; }
+
+MethodStatus MethodStatusOf(const nlohmann::json& record) {
+  return record.value("status", "") == ToString(MethodStatus::kOk) ? MethodStatus::kOk : MethodStatus::kFailed;
+}
 namespace {
 
 using nlohmann::json;
@@ -190,7 +196,7 @@ void ReportIntervals(const Scenario& s, const SetMembershipClass& cls, const std
   (*out)["intervals"] = ivs;
   (*out)["coverage"] = {{"covered", covered}, {"total", intervals.size()}, {"all_guaranteed", all_guaranteed}};
   (*out)["mean_width"] = intervals.empty() ? 0.0 : width_sum / intervals.size();
-  (*out)["status"] = "ok";
+  (*out)["status"] = ToString(MethodStatus::kOk);
   if (intervals.size() == cls.names.size()) {
     // Point estimate: the centre of the interval box (each parameter's midpoint).
     (*out)["point_estimate"] = {{"names", cls.names}, {"values", mid}, {"kind", "midpoints of the intervals"}};
@@ -228,7 +234,7 @@ json RunExactSet(const Scenario& s, const SetMembershipClass& cls, const OuterSe
   out["samples"] = run.data.u.size();
   out["stage1_seconds"] = run.summary.wall_seconds;  // the D^ss(n) run, shared with `setmembership`
   if (run.summary.invalidated()) {
-    out["status"] = "failed";
+    out["status"] = ToString(MethodStatus::kFailed);
     out["message"] = "D^ss(n) is empty (certified), and D with it: no model of the class explains the record";
     return out;
   }
@@ -241,7 +247,7 @@ json RunExactSet(const Scenario& s, const SetMembershipClass& cls, const OuterSe
   out["invalidated"] = summary.invalidated;
   out["stage2"] = summary.to_json().at("stage2");
   if (summary.invalidated) {
-    out["status"] = "failed";
+    out["status"] = ToString(MethodStatus::kFailed);
     out["message"] = "the exact set is empty (certified): no model of the class explains the record";
     return out;
   }
@@ -346,10 +352,10 @@ json RunEsmaeilani(const Scenario& s, const std::vector<Record>& recs, const Rec
   out["final_cost"] = sum.final_cost;
   out["message"] = sum.message;
   if (!sum.ok()) {
-    out["status"] = "failed";
+    out["status"] = ToString(MethodStatus::kFailed);
     return out;
   }
-  out["status"] = "ok";
+  out["status"] = ToString(MethodStatus::kOk);
   Plant est;
   est.model = m.ToHwModel(true);
   out["model"] = est.model.to_json();
@@ -375,16 +381,16 @@ json RunBrouri(const Scenario& s, std::uint64_t seed) {
   const auto r = brouri::RunWorkflow(s.backlash, cfg, seed);
   out["message"] = r.nonlinear_summary.message;
   if (!r.nonlinear_summary.ok) {
-    out["status"] = "failed";
+    out["status"] = ToString(MethodStatus::kFailed);
     return out;
   }
   for (const auto& ps : r.point_summaries)
     if (!ps.ok) {
-      out["status"] = "failed";
+      out["status"] = ToString(MethodStatus::kFailed);
       out["message"] = "frequency stage: " + ps.message;
       return out;
     }
-  out["status"] = "ok";
+  out["status"] = ToString(MethodStatus::kOk);
   // Static: the two steady-state borders of the normalised model (same input-output behaviour as the plant).
   const auto truth = s.backlash.Normalised();
   const auto tl = brouri::LinesOf(truth.kind, truth.backlash);
@@ -577,14 +583,14 @@ nlohmann::json RunOne(const Scenario& s, const std::vector<std::string>& methods
       }
     } catch (const std::exception& e) {
       // A method that fails is reported, never dropped.
-      m = {{"applicable", true}, {"status", "failed"}, {"message", e.what()}};
+      m = {{"applicable", true}, {"status", ToString(MethodStatus::kFailed)}, {"message", e.what()}};
     }
     m["experiment"] = app.experiment;
     m["seconds"] = Seconds(t0);
     out["methods"][method] = m;
   }
   // Point estimates mapped into the set-membership parametrisation against its intervals.
-  if (out["methods"].contains("setmembership") && out["methods"]["setmembership"].value("status", "") == "ok") {
+  if (out["methods"].contains("setmembership") && MethodStatusOf(out["methods"]["setmembership"]) == MethodStatus::kOk) {
     const auto& ivs = out["methods"]["setmembership"]["intervals"];
     for (auto& [name, m] : out["methods"].items()) {
       if (!m.contains("setmembership_parametrisation")) continue;

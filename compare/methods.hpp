@@ -15,6 +15,12 @@
 
 namespace hw::compare {
 
+// How a method's run ended, as a run record's "status" stores it.
+enum class MethodStatus { kOk, kFailed };
+std::string ToString(MethodStatus status);
+// The status a run record holds; a record without one, or with an unknown one, counts as failed.
+MethodStatus MethodStatusOf(const nlohmann::json& record);
+
 struct Record {
   std::vector<double> u, w, y;  // input, noise-free output, measured output
 };

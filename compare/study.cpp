@@ -88,7 +88,7 @@ json Aggregate(const Scenario& scenario, const std::vector<json>& runs) {
       }
       applicable = true;
       if (m.contains("seconds")) times.push_back(m["seconds"].get<double>());
-      if (m.value("status", "") != "ok") {
+      if (MethodStatusOf(m) != MethodStatus::kOk) {
         failures.push_back({{"run", r["run"]}, {"message", m.value("message", "")}});
         all_ok = false;
         continue;
