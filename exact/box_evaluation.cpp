@@ -215,7 +215,12 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
       const double beta = s.result.primal[lifted.beta_col[ratio_j][k]], bj = s.result.primal[lifted.beta_col[ratio_j][0]];
       out.lp_value = beta / bj;
       const double g_next = beta / bj;
-      if (!std::isfinite(g_next) || std::abs(g_next - g) <= 1e-12 * std::max(1.0, std::abs(g))) break;
+      // Converged once the ratio moves by less than a millionth of the box: a simplex returns the same vertex
+      // and stops at once, an interior point's central solution keeps moving by rounding amounts (without this
+      // every box would spend all its steps, and the budget with them).
+      const double settled = std::max(1e-12 * std::max(1.0, std::abs(g)),
+                                      1e-6 * (box[objective.parameter].hi - box[objective.parameter].lo));
+      if (!std::isfinite(g_next) || std::abs(g_next - g) <= settled) break;
       g = g_next;
     }
     out.bound = best;
