@@ -297,7 +297,7 @@ class InteriorPoint {
   static constexpr double kStalledGapTolerance = 1e-7;
 
   void Start() {
-    const int n = f_.n, m = f_.m;
+    const int m = f_.m;
     it_.x = 0.5 * (f_.col_lo + f_.col_hi);
     const Vector ax = f_.A * it_.x;
     it_.r = ax;
@@ -321,7 +321,6 @@ class InteriorPoint {
       if (Finite(f_.row_lo[i])) it_.zrl[i] = 1.0 / (it_.r[i] - f_.row_lo[i]);
       if (Finite(f_.row_hi[i])) it_.zru[i] = 1.0 / (f_.row_hi[i] - it_.r[i]);
     }
-    (void)n;
   }
 
   // Residuals of the current iterate: rp = Ax - r, rd_x = c - A'y - zl + zu, rd_r = y - zrl + zru.
