@@ -371,7 +371,29 @@ Reference ReplaceByRicher(const Context& c, const Reference& ref, DiagnoseReport
   return out;
 }
 
-// Baseline: the nominal refitted alone, from the given numbers and (structure known) fresh starts.
+// The nominal's structure: `structure` when given (--fit), else read from the model (identity or
+// polynomial maps, into *storage); null when unknown (piecewise-linear maps).
+const NominalSpec* KnownStructure(const AugmentedModel& nominal, const NominalSpec* structure, NominalSpec* storage) {
+  if (structure) return structure;
+  return NominalSpec::Of(nominal.nominal, storage) ? storage : nullptr;
+}
+
+// The reference every candidate is compared with, from a nominal fitted on the fitting part: its
+// residuals, its refit on the whole identification recording and (structure known) the richer nominals.
+Reference ReferenceFrom(const Context& c, const AugmentedModel& fitted, const NominalSpec* spec, DiagnoseReport* r) {
+  Reference ref;
+  ref.fitted = fitted;
+  ref.ident_residual = c.IdentResidual(fitted);
+  ref.full = RefitModel(fitted, c.full, c.o.refit).model;
+  ref.valid_residual = c.ValidationResidual(ref.full);
+  if (c.o.richer_nominal && spec) Richer(c, *spec, &ref, r);
+  if (c.o.swapped_min_improvement < 1.0)
+    ref.swapped_residual = c.SwappedResidual(RefitModel(ref.fitted, c.full, c.o.refit).model);
+  return ref;
+}
+
+// Baseline: the nominal refitted alone, from the given numbers and, when its structure is known
+// (`structure`, see KnownStructure), from fresh starts.
 Reference Baseline(const Context& c, const AugmentedModel& nominal, const NominalSpec* structure,
                    DiagnoseReport* r) {
   const Segment held{&c.ident.u, &c.ident.y, c.nfit, c.n};
@@ -380,12 +402,11 @@ Reference Baseline(const Context& c, const AugmentedModel& nominal, const Nomina
   r->baseline_source = "the given nominal model, refitted";
   r->baseline_starts.push_back({r->baseline_source, std::sqrt(SumSquaredError(best, c.fit) / c.fit.Count()),
                                 holdout_rmse(best)});
-  NominalSpec spec;
-  if (structure || NominalSpec::Of(nominal.nominal, &spec)) {
+  if (structure) {
     NominalFitOptions no = c.o.nominal_fit;
     no.refit = c.o.refit;
     try {
-      const NominalFit fresh = FitNominal(structure ? *structure : spec, c.fit, no);  // chooses inside the fitting part
+      const NominalFit fresh = FitNominal(*structure, c.fit, no);  // chooses inside the fitting part
       const double h = holdout_rmse(fresh.model);
       r->baseline_starts.push_back({"fresh starts: " + fresh.Summary(),
                                     std::sqrt(SumSquaredError(fresh.model, c.fit) / c.fit.Count()), h});
@@ -397,16 +418,40 @@ Reference Baseline(const Context& c, const AugmentedModel& nominal, const Nomina
       r->baseline_starts.push_back({std::string("fresh starts not possible: ") + e.what(), HUGE_VAL, HUGE_VAL});
     }
   }
-  Reference ref;
-  ref.fitted = best;
-  ref.ident_residual = c.IdentResidual(best);
-  ref.full = RefitModel(best, c.full, c.o.refit).model;
-  ref.valid_residual = c.ValidationResidual(ref.full);
-  if (c.o.richer_nominal && (structure || NominalSpec::Of(nominal.nominal, &spec)))
-    Richer(c, structure ? *structure : spec, &ref, r);
-  if (c.o.swapped_min_improvement < 1.0)
-    ref.swapped_residual = c.SwappedResidual(RefitModel(ref.fitted, c.full, c.o.refit).model);
-  return ref;
+  return ReferenceFrom(c, best, structure, r);
+}
+
+// An effect block can carry the nominal to a better optimum of its own structure than every start of
+// the baseline reached (a delay fitted with fresh poles, a numerator reshaped around a limit). The
+// nominal part of each candidate that improved the held-out tail, its blocks removed, is refitted alone
+// as one more start; when the best such start beats the baseline significantly on the held-out tail,
+// the baseline was a poor optimum, not a sign of the effect: it is replaced (and the search repeated).
+bool BetterNominalFromCandidates(const Context& c, const std::vector<Finding>& findings, const NominalSpec* spec,
+                                 Reference* ref, DiagnoseReport* r) {
+  const Segment held{&c.ident.u, &c.ident.y, c.nfit, c.n};
+  double best_mse = Mse(ref->ident_residual, c.nfit, c.n);
+  AugmentedModel best;
+  std::string from;
+  int tried = 0;
+  for (const auto& f : findings) {
+    if (!f.holdout.significant || tried >= 4) continue;
+    ++tried;
+    AugmentedModel start = f.fitted;
+    start.blocks.clear();
+    const AugmentedModel m = RefitModel(start, c.fit, c.o.refit).model;
+    const double mse = SumSquaredError(m, held) / std::max<std::size_t>(held.Count(), 1);
+    if (std::isfinite(mse) && mse < best_mse && MapsMonotone(m, c.ident.u)) best_mse = mse, best = m, from = f.Label();
+  }
+  if (from.empty()) return false;
+  const Comparison h = c.Compare(ref->ident_residual, c.IdentResidual(best), c.nfit, c.n, 0, c.o.significance_z);
+  if (!h.significant) return false;
+  const Segment fit = c.fit;
+  r->baseline_starts.push_back({"the nominal part of the " + from + " fit, refitted alone",
+                                std::sqrt(SumSquaredError(best, fit) / fit.Count()), std::sqrt(best_mse)});
+  r->baseline_source = "the nominal part of the " + from + " fit, refitted alone (a better optimum of the nominal structure)";
+  r->richer_note.clear();
+  *ref = ReferenceFrom(c, best, spec, r);
+  return true;
 }
 
 // Stiction without a stick-slip jump (kinetic band within 2 % of the static band) is backlash with one
@@ -649,7 +694,8 @@ void Locate(const Context& c, bool verdict, const Vec& e_nom, const Vec& v_refit
 }
 
 // Did the baseline reach the noise floor on the held-out tail? When it did not, a verdict is kept only
-// if it explains at least half of the excess mean square; otherwise the fit failed and no effect is named.
+// if it explains at least half of the excess mean square (held-out tail or validation); otherwise the fit
+// failed and no effect is named.
 const Finding* JudgeNominal(const Context& c, const Reference& base, const Finding* verdict, DiagnoseReport* r) {
   const double sigma = r->noise_std;
   const double mse_base = Mse(base.ident_residual, c.nfit, c.n);
@@ -667,6 +713,13 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
     // Confirmed with the roles swapped: the excess is the one of the reference refitted on validation.
     const double swapped_excess = verdict->swapped.mse_baseline - sigma * sigma;
     explained = std::max(explained, swapped_excess > 0 ? (verdict->swapped.mse_baseline - verdict->swapped.mse) / swapped_excess : 1.0);
+  }
+  // The held-out tail may hold little of what the effect does (a limit reached only early in the
+  // recording): the excess is also measured on the validation recording, which no fit has seen.
+  if (verdict) {
+    const double valid_excess = verdict->validation.mse_baseline - sigma * sigma;
+    if (valid_excess > 0)
+      explained = std::max(explained, (verdict->validation.mse_baseline - verdict->validation.mse) / valid_excess);
   }
   if (verdict && explained >= 0.5) {
     r->nominal_status = NominalStatus::kExplainedByEffect;
@@ -799,8 +852,11 @@ void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const Nom
   r.input_corr_nominal = InputCorrelationTest(e_nom, ident.u, c.skip, o.max_lag);
 
   // Baseline, every single block, and a combination of two when it beats the best single one.
-  Reference base = Baseline(c, nominal, structure, &r);
+  NominalSpec spec;
+  const NominalSpec* known = KnownStructure(nominal, structure, &spec);
+  Reference base = Baseline(c, nominal, known, &r);
   r.findings = SearchSingles(c, base);
+  if (BetterNominalFromCandidates(c, r.findings, known, &base, &r)) r.findings = SearchSingles(c, base);
   if (base.replacement >= 0 && (r.findings.empty() || !r.findings.front().eligible)) {
     base = ReplaceByRicher(c, base, &r);
     r.findings = SearchSingles(c, base);
