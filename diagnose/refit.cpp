@@ -672,7 +672,10 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   RefitResult best;
   best.sse = std::numeric_limits<double>::infinity();
-  const int keep = std::min<int>(o.keep_grid_points, static_cast<int>(scored.size()));
+  // A quantizer's cost is jagged in its step (every step size shifts which levels the data land on): its
+  // grid points scored with the baseline's numerator are a poor guide, and more of them are refined.
+  const int refine = effect == Effect::kQuantization ? 4 * o.keep_grid_points : o.keep_grid_points;
+  const int keep = std::min<int>(refine, static_cast<int>(scored.size()));
   for (int i = 0; i < keep; ++i) {
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);
