@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/cerone_example.hpp"
 #include "exact/inner_hull.hpp"
@@ -28,12 +29,14 @@ int main(int argc, char** argv) {
   std::vector<int> samples{300, 1000, 3000, 10000};
   double snr = 31.0, time_limit = 600.0;
   int seed = 1, restarts = 0, repeats = 5;
+  bool print_points = false;
   app.add_option("--samples", samples)->delimiter(',');
   app.add_option("--snr", snr, "SNR_w in dB (31 is the paper's)");
   app.add_option("--seed", seed);
   app.add_option("--restarts", restarts, "extra local starts per objective");
   app.add_option("--repeats", repeats, "membership checks timed per N (median reported)")->check(CLI::PositiveNumber);
   app.add_option("--time-limit", time_limit, "seconds per inner hull");
+  app.add_flag("--points", print_points, "print every certified point of D (layout order)");
   CLI11_PARSE(app, argc, argv);
   const auto truth = hw::CeroneExample::TrueParameters();
   auto solver = hw::exact::MakeLpSolver("clp");
@@ -65,6 +68,8 @@ int main(int argc, char** argv) {
       }
       fmt::print("  {:>7} [{:.6f}, {:.6f}]\n", lifted.layout.names[k], hull.ranges[k]->first, hull.ranges[k]->second);
     }
+    if (print_points)
+      for (const auto& p : hull.points) fmt::print("  point ({}): {:.7f}\n", p.objective, fmt::join(p.theta, " "));
     fmt::print("  inner hull: {} local solves, {} points, {:.1f} s\n", hull.local_solves, hull.points.size(),
                hull.seconds);
   }

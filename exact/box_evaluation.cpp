@@ -50,17 +50,20 @@ std::vector<double> ParameterValues(const LiftedLp& lifted, const std::vector<do
   return p;
 }
 
-// The b_j (index into beta_col) of one sign over the box farthest from zero, or -1.
-int RatioDenominator(const LiftedData& data, const ParamBox& box) {
+// The b_j (index into beta_col) of one sign over the box: the turn-th farthest from zero (cyclically), or -1.
+// gamma_k = beta_jk / b_j for every such j, but the relaxation leaves the beta_jk of different j free of each
+// other, so each ratio bounds gamma_k differently; boxes of a search take them in turn and keep the tightest.
+int RatioDenominator(const LiftedData& data, const ParamBox& box, int turn) {
   const auto& lay = data.layout;
-  int best = -1;
-  double best_margin = 0.0;
+  std::vector<std::pair<double, int>> signed_b;  // (-margin, j): farthest first, then by index
   for (int j = 0; lay.b_begin + j < lay.count(); ++j) {
     const Interval b = box[lay.b_begin + j];
     const double margin = b.lo > 0 ? b.lo : (b.hi < 0 ? -b.hi : 0.0);
-    if (margin > best_margin) best_margin = margin, best = j;
+    if (margin > 0.0) signed_b.emplace_back(-margin, j);
   }
-  return best;
+  if (signed_b.empty()) return -1;
+  std::sort(signed_b.begin(), signed_b.end());
+  return signed_b[static_cast<std::size_t>(turn) % signed_b.size()].second;
 }
 
 }  // namespace
@@ -149,7 +152,8 @@ bool Usable(const BoundSolve& s) { return s.result.status == LpStatus::kOptimal 
 }  // namespace
 
 BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
-                             const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm) {
+                             const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm,
+                             int denominator_turn) {
   const auto start = Clock::now();
   const auto& lay = data.layout;
   const double sign = objective.maximise ? -1.0 : 1.0;  // every LP minimises sign * objective
@@ -164,9 +168,9 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     return empty;
   };
   const bool is_gamma = objective.parameter >= lay.gamma_begin && objective.parameter < lay.gamma_begin + lay.num_gamma;
-  const int ratio_j = is_gamma ? RatioDenominator(data, box) : -1;
+  const int ratio_j = is_gamma ? RatioDenominator(data, box, denominator_turn) : -1;
   if (ratio_j < 0) {
-    std::vector<double> weights(lay.count(), 0.0);
+    std::vector<double> weights(lifted.param_col.size(), 0.0);
     weights[objective.parameter] = sign;
     lifted.SetParameterObjective(weights);
     LpSolveOptions lp = options.lp;

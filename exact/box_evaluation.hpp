@@ -58,8 +58,10 @@ BoxEvaluation TestBoxEmpty(const LiftedData& data, const ParamBox& box, const Bo
                            LpSolver& solver, const LpBasis& warm = {});
 // The objective's rigorous bound over the box (min: a lower bound; max: an upper bound). An infeasible LP
 // leads to the emptiness test on the whole record.
+// `denominator_turn` picks which b_j of one sign divides a gamma (the farthest from zero first, cyclically).
 BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
-                             const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm = {});
+                             const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm = {},
+                             int denominator_turn = 0);
 
 // The whole record as a window.
 Window WholeRecord(const LiftedData& data);

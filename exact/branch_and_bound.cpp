@@ -10,11 +10,14 @@ int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& 
   const auto& lay = data.layout;
   int best = lay.a_begin;
   double best_ratio = -1.0;
-  for (int i = 0; i < data.structure.na; ++i) {
-    const int k = lay.a_begin + i;
+  auto consider = [&](int k) {
     const double ratio = (box[k].hi - box[k].lo) / (start[k].hi - start[k].lo);
     if (ratio > best_ratio) best_ratio = ratio, best = k;
-  }
+  };
+  // Forms first: on a tie the cut across D's strip removes more.
+  if (box.size() == start.size())
+    for (std::size_t k = lay.count(); k < box.size(); ++k) consider(static_cast<int>(k));
+  for (int i = 0; i < data.structure.na; ++i) consider(lay.a_begin + i);
   return best;
 }
 
@@ -51,6 +54,23 @@ bool PruneSearchDone(const LiftedData& data, const std::vector<ParamBox>& live, 
       if ((box[k].hi - box[k].lo) * stop.resolution > (hull[k].hi - hull[k].lo)) return false;
     }
   return true;
+}
+
+std::string ToString(EndpointSplit split) {
+  switch (split) {
+    case EndpointSplit::kDynamics: return "dynamics";
+    case EndpointSplit::kAlternate: return "alternate";
+  }
+  return "dynamics";
+}
+
+bool ParseEndpointSplit(const std::string& text, EndpointSplit* split) {
+  for (EndpointSplit s : {EndpointSplit::kDynamics, EndpointSplit::kAlternate})
+    if (text == ToString(s)) {
+      *split = s;
+      return true;
+    }
+  return false;
 }
 
 bool ObjectiveSearchOptions::IsValid(std::string* error) const {
@@ -107,7 +127,18 @@ struct SearchBox {
   double lp_value = 0.0;
   std::vector<double> point;
   LpBasis basis;
+  int objective_splits = 0, dynamics_splits = 0;  // along the box's lineage
 };
+
+// Where to cut the objective's own range [lo, hi] (hi: the box's proven bound, in maximisation terms): with a
+// point of D at `target` inside, just far enough beyond it that cutting off the far slab would end the search
+// (or halfway to the bound, whichever is farther); else the middle.
+double ObjectiveCut(Interval range, bool maximise, std::optional<double> target, double target_gap) {
+  if (!target || !(*target > range.lo && *target < range.hi)) return range.mid();
+  const double room = maximise ? range.hi - *target : *target - range.lo;
+  const double step = std::max(0.5 * room, std::min(target_gap, 0.75 * room));
+  return maximise ? *target + step : *target - step;
+}
 
 }  // namespace
 
@@ -132,7 +163,9 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
     SearchBox& box = live[w];
     if (!box.evaluated) {
       if (out.lps >= options.lp_budget) break;
-      BoxEvaluation e = BoundObjective(data, box.box, objective, accuracy, solver, box.basis);
+      // Children divide a gamma by the next b_j in turn: a box keeps the tighter of its own and its parent's bound.
+      const int turn = options.rotate_denominators ? box.objective_splits + box.dynamics_splits : 0;
+      BoxEvaluation e = BoundObjective(data, box.box, objective, accuracy, solver, box.basis, turn);
       out.lps += e.lps;
       out.lp_failures += e.lp_failures;
       if (e.verdict == BoxVerdict::kPruned) {
@@ -147,17 +180,40 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
         box.from_lp = true;
         box.lp_value = e.lp_value;
       }
+      // No point of D in the box lies beyond its bound: the box shrinks to it (tighter envelopes for children).
+      if (e.bound) {
+        Interval& r = box.box[p];
+        if (objective.maximise) r.hi = std::max(r.lo, std::min(r.hi, *e.bound));
+        else r.lo = std::min(r.hi, std::max(r.lo, *e.bound));
+      }
       if (!e.point.empty()) box.point = e.point;
       if (!e.basis.empty()) box.basis = e.basis;
       continue;
     }
     if (target && box.bound >= sign * *target - target_gap) break;  // within the target of a point of D
     if (out.lps >= options.lp_budget) break;
-    const int k = SplitParameter(data, box.box, start);
+    const bool is_dynamics =
+        (p >= data.layout.a_begin && p < data.layout.a_begin + data.structure.na) || p >= data.layout.count();
+    const bool cut_objective = options.split == EndpointSplit::kAlternate && !is_dynamics &&
+                               box.objective_splits <= box.dynamics_splits;
+    const int k = cut_objective ? p : SplitParameter(data, box.box, start);
     if (box.box[k].hi - box.box[k].lo < options.min_relative_width * (start[k].hi - start[k].lo)) break;
-    auto [lower, upper] = HalveBox(box.box, k);
-    SearchBox a{lower, box.bound, false, box.from_lp, box.lp_value, box.point, box.basis};
-    SearchBox b{upper, box.bound, false, box.from_lp, box.lp_value, box.point, box.basis};
+    const double cut = cut_objective ? ObjectiveCut(box.box[p], objective.maximise, target, target_gap)
+                                     : box.box[k].mid();
+    SearchBox a = box, b = box;
+    a.evaluated = b.evaluated = false;
+    a.box[k].hi = cut;
+    b.box[k].lo = cut;
+    for (SearchBox* c : {&a, &b}) {
+      PropagateForms(data, c->box);
+      (cut_objective ? c->objective_splits : c->dynamics_splits) += 1;
+      // A child cut in the objective's range can reach no farther than its own edge.
+      const double edge = objective.maximise ? -c->box[p].hi : c->box[p].lo;
+      if (cut_objective && edge > c->bound) {
+        c->bound = edge;  // proven by the sibling's answer, once the sibling is done
+        c->lp_value = sign * edge;
+      }
+    }
     live.erase(live.begin() + static_cast<long>(w));
     live.insert(live.begin() + static_cast<long>(w), {a, b});
   }

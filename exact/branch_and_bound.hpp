@@ -34,8 +34,19 @@ struct PruneStop {
 // Whether the pruning search has reached its stop (boxes small against their hull, or a limit).
 bool PruneSearchDone(const LiftedData& data, const std::vector<ParamBox>& live, int level, const PruneStop& stop);
 
+// What an endpoint's refinement halves once a box's LP bound is known.
+enum class EndpointSplit {
+  kDynamics,   // the a_i only (the relaxation's products a_i z_{t-i} tighten)
+  kAlternate,  // the a_i and the endpoint's own parameter in turn: a slab beyond the inner hull is cut off, and a
+               // narrow gamma_k ties every beta_jk = b_j gamma_k (the input side's over-parametrisation)
+};
+std::string ToString(EndpointSplit split);
+bool ParseEndpointSplit(const std::string& text, EndpointSplit* split);
+
 struct ObjectiveSearchOptions {
   int lp_budget = 24;              // LPs of one endpoint's refinement
+  EndpointSplit split = EndpointSplit::kDynamics;
+  bool rotate_denominators = false;  // gamma through each b_j of one sign in turn (by depth), not the largest only
   double min_relative_width = 1e-9;  // a box narrower than this (relative to the start box) is not halved
   bool IsValid(std::string* error) const;
 };

@@ -136,35 +136,62 @@ std::vector<int> WantedParameters(const ExactBoundsOptions& options, const dss::
   return wanted;
 }
 
-// Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter) refined.
+using InnerRanges = std::vector<std::optional<std::pair<double, double>>>;
+
+// The inner hull's ranges for every entry of a box with forms: the parameters', then each form's over the points.
+InnerRanges InnerRangesWithForms(const LiftedData& data, const InnerHull& inner) {
+  InnerRanges ranges = inner.ranges;
+  const int a0 = data.layout.a_begin;
+  for (const auto& form : data.dynamics_forms) {
+    std::optional<std::pair<double, double>> r;
+    for (const auto& p : inner.points) {
+      double v = 0.0;
+      for (std::size_t i = 0; i < form.size(); ++i) v += form[i] * p.theta[a0 + i];
+      r = r ? std::pair{std::min(r->first, v), std::max(r->second, v)} : std::pair{v, v};
+    }
+    ranges.push_back(r);
+  }
+  return ranges;
+}
+
+// Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter and form)
+// refined. The forms' new ranges go to `form_ranges`.
 void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
-                const InnerHull* inner, double target_ratio, JobRunner& runner, ExactBoundsSummary& s,
-                std::vector<ExactInterval>& intervals, const std::function<void(int, int)>& on_done) {
+                const InnerRanges* inner, double target_ratio, JobRunner& runner, ExactBoundsSummary& s,
+                std::vector<ExactInterval>& intervals, std::vector<Interval>& form_ranges, bool forms_only,
+                const std::function<void(int, int)>& on_done) {
   const auto& lay = data.layout;
   std::vector<nlohmann::json> specs;
   std::vector<Objective> objectives;
-  for (int k = 0; k < lay.count(); ++k)
+  for (int k = forms_only ? lay.count() : 0; k < static_cast<int>(start.size()); ++k)
     for (bool maximise : {false, true}) {
       std::optional<double> target;
       double gap = 0.0;
-      if (inner && inner->ranges[k]) {
-        const auto [lo, hi] = *inner->ranges[k];
+      if (inner && (*inner)[k]) {
+        const auto [lo, hi] = *(*inner)[k];
         target = maximise ? hi : lo;
         // Each end may be this far outside the inner hull for outer/inner <= target_ratio.
         gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
       }
       objectives.push_back({k, maximise});
-      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap));
+      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms));
     }
   const auto answers = runner.Run(specs, on_done);
   for (std::size_t o = 0; o < objectives.size(); ++o) {
     const Objective& obj = objectives[o];
-    ExactEndpoint& end = obj.maximise ? intervals[obj.parameter].upper : intervals[obj.parameter].lower;
     if (answers[o].is_null()) continue;  // the job failed: the endpoint keeps what it had
     const ObjectiveSearchResult r = ObjectiveSearchResult::from_json(answers[o]);
     s.lps += r.lps;
     s.lp_failures += r.lp_failures;
     s.boxes_pruned += r.boxes_pruned;
+    if (obj.parameter >= lay.count()) {  // a form: its range only narrows the next sweep's box
+      Interval& range = form_ranges[obj.parameter - lay.count()];
+      if (r.empty) continue;
+      if (obj.maximise) range.hi = std::min(range.hi, r.bound);
+      else range.lo = std::max(range.lo, r.bound);
+      continue;
+    }
+    ExactEndpoint& end = obj.maximise ? intervals[obj.parameter].upper : intervals[obj.parameter].lower;
     if (r.empty) {
       end.status = EndpointStatus::kEmpty;
       continue;
@@ -224,6 +251,7 @@ bool ExactBoundsOptions::IsValid(std::string* error) const {
   };
   if (!ValidLpSolverName(lp_solver, error)) return false;
   if (!evaluation.IsValid(error) || !prune.IsValid(error) || !search.IsValid(error)) return false;
+  if (dynamics_forms && !forms.IsValid(error)) return false;
   if (sweeps < 1 || sweeps > 5) return fail(fmt::format("sweeps must be 1..5, not {}", sweeps));
   if (!(target_ratio >= 1.0)) return fail("target_ratio must be >= 1");
   if (threads < 0) return fail("threads must be >= 0 (0 = one per core)");
@@ -258,7 +286,7 @@ nlohmann::json ExactBoundsSummary::to_json() const {
             {"jobs_from_cache", jobs_from_cache}, {"lp_rows", lp_rows}, {"lp_cols", lp_cols},
             {"lp_nonzeros", lp_nonzeros}, {"prune_seconds", prune_seconds}, {"inner_seconds", inner_seconds},
             {"bound_seconds", bound_seconds}, {"wall_seconds", wall_seconds}, {"inner_points", inner_points},
-            {"executor", executor}, {"lp_solver", lp_solver}}}};
+            {"executor", executor}, {"lp_solver", lp_solver}, {"dynamics_forms", FormsToJson(dynamics_forms)}}}};
 }
 
 ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
@@ -300,6 +328,9 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
                          {"start_box", BoxToJson(start_box)},
                          {"lp_solver", options.lp_solver},
                          {"lp_budget", options.search.lp_budget},
+                         {"split", ToString(options.search.split)},
+                         {"rotate_denominators", options.search.rotate_denominators},
+                         {"dynamics_forms", options.dynamics_forms ? options.forms.thin_share : 0.0},
                          {"cheap_windows", {ev.cheap_window, ev.cheap_windows}},
                          {"lp_tolerances", {ev.lp.primal_tolerance, ev.lp.dual_tolerance, ev.lp.time_limit_seconds}}};
   const std::string key = JobKey(meta.dump() + std::to_string(lifted.num_samples));
@@ -347,17 +378,38 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     for (int k = 0; k < lay.count(); ++k) s.intervals[k].inner = inner->ranges[k];
   }
 
+  // Forms across D's thin directions, from the inner hull's points (exact/dynamics_forms.hpp).
+  LiftedData with_forms = lifted;
+  if (inner && options.dynamics_forms) {
+    std::vector<std::vector<double>> points;
+    for (const auto& p : inner->points) points.push_back(p.theta);
+    with_forms.dynamics_forms = ThinDirections(lifted, points, options.forms);
+  }
+  s.dynamics_forms = with_forms.dynamics_forms;
+  std::optional<InnerRanges> inner_ranges;
+  if (inner) inner_ranges = InnerRangesWithForms(with_forms, *inner);
+
   // 3. bound, in sweeps: each later sweep starts in the box the earlier ones proved.
   t = Clock::now();
-  for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-    const std::string phase = fmt::format("bound (sweep {} of {}, endpoints)", sweep + 1, options.sweeps);
+  std::vector<Interval> form_ranges(with_forms.dynamics_forms.size(), Interval(-INFINITY, INFINITY));
+  // The forms' own ranges first (sweep 0): every endpoint's search then starts with D's strip already narrow,
+  // instead of each one cutting it down on its own.
+  for (int sweep = form_ranges.empty() ? 1 : 0; sweep <= options.sweeps; ++sweep) {
+    const std::string phase = sweep == 0 ? std::string("bound (the dynamics forms)")
+                                         : fmt::format("bound (sweep {} of {}, endpoints)", sweep, options.sweeps);
     ParamBox sweep_start = start_box;
     for (int k = 0; k < lay.count(); ++k) sweep_start[k] = Interval(s.intervals[k].lower.value, s.intervals[k].upper.value);
+    sweep_start = WithFormRanges(with_forms, sweep_start);
+    for (std::size_t f = 0; f < form_ranges.size(); ++f) {
+      Interval& range = sweep_start[lay.count() + f];
+      range = {std::max(range.lo, form_ranges[f].lo), std::min(range.hi, form_ranges[f].hi)};
+    }
+    PropagateForms(with_forms, sweep_start);
     // Each endpoint's search starts from the live hull (one box): it halves only where its bound is worst, which
     // costs fewer LPs than bounding every live box of the pruning search first.
     const std::vector<ParamBox> sweep_boxes = {sweep_start};
-    BoundSweep(lifted, sweep_start, sweep_boxes, inner ? &*inner : nullptr, options.target_ratio, runner, s, s.intervals,
-               [&](int done, int total) {
+    BoundSweep(with_forms, sweep_start, sweep_boxes, inner_ranges ? &*inner_ranges : nullptr, options.target_ratio,
+               runner, s, s.intervals, form_ranges, sweep == 0, [&](int done, int total) {
                  if (progress) progress({phase, done, total, "", SecondsSince(t0)});
                });
   }

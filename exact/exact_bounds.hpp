@@ -45,6 +45,9 @@ struct ExactBoundsOptions {
   PruneStop prune;
   ObjectiveSearchOptions search;
   int sweeps = 2;                 // bounding sweeps; each after the first starts in the box the previous proved
+  // Bound and halve forms across D's thin directions in (a_1..a_na) too (exact/dynamics_forms.hpp).
+  bool dynamics_forms = true;
+  DynamicsFormOptions forms;
   double target_ratio = 1.25;     // stop refining an endpoint once outer/inner width would be at most this
   bool inner_hull = true;
   InnerHullOptions inner = NoRestarts();  // restarts measured to cost 15x for no wider range (docs/exact_set.md)
@@ -103,6 +106,7 @@ struct ExactBoundsSummary {
   AssumptionCheck assumption;
   std::string executor;
   std::string lp_solver;       // the LP backend that ran (certificates do not depend on it)
+  std::vector<DynamicsForm> dynamics_forms;  // the forms the bounding sweeps used
   bool worker_rank = false;
   nlohmann::json to_json() const;
 };

@@ -57,12 +57,14 @@ nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool c
 }
 
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
-                                std::optional<double> target, double target_gap) {
+                                std::optional<double> target, double target_gap,
+                                const std::vector<DynamicsForm>& forms) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& b : boxes) list.push_back(BoxToJson(b));
   nlohmann::json j = {{"kind", kObjectiveKind}, {"start", BoxToJson(start)}, {"boxes", list},
                       {"parameter", objective.parameter}, {"maximise", objective.maximise}, {"target_gap", target_gap}};
   j["target"] = target ? nlohmann::json(*target) : nlohmann::json(nullptr);
+  if (!forms.empty()) j["forms"] = FormsToJson(forms);
   return j;
 }
 
@@ -96,9 +98,15 @@ sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSett
     const Objective objective{spec.at("parameter").get<int>(), spec.at("maximise").get<bool>()};
     std::optional<double> target;
     if (!spec.at("target").is_null()) target = spec.at("target").get<double>();
+    // The forms travel in the spec: an MPI rank's data has none of the coordinator's.
+    LiftedData with_forms;
+    if (spec.contains("forms")) {
+      with_forms = data;
+      with_forms.dynamics_forms = FormsFromJson(spec.at("forms"));
+    }
     const ObjectiveSearchResult r =
-        SearchObjective(data, BoxFromJson(spec.at("start")), boxes, objective, target,
-                        spec.at("target_gap").get<double>(), settings.search, settings.evaluation, *solver);
+        SearchObjective(spec.contains("forms") ? with_forms : data, BoxFromJson(spec.at("start")), boxes, objective,
+                        target, spec.at("target_gap").get<double>(), settings.search, settings.evaluation, *solver);
     return r.to_json().dump();
   };
 }

@@ -21,7 +21,8 @@ struct ExactJobSettings {
 // `cheap_windows`: try the cheap windows first (the pruning search stops once a level prunes nothing with them).
 nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool cheap_windows);
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
-                                std::optional<double> target, double target_gap);
+                                std::optional<double> target, double target_gap,
+                                const std::vector<DynamicsForm>& forms = {});
 
 // Answers either kind of spec (called in the worker process).
 sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSettings& settings);

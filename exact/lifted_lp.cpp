@@ -123,7 +123,11 @@ LiftedLp BuildLiftedLp(const LiftedData& d, const ParamBox& box, Window window, 
 
   // Parameter columns, in the layout's order.
   out.param_col.resize(lay.count());
+  if (static_cast<int>(box.size()) > lay.count() && box.size() != lay.count() + d.dynamics_forms.size())
+    throw InputError("a box with form ranges needs one per dynamics form");
   for (int k = 0; k < lay.count(); ++k) out.param_col[k] = lp.AddColumn(box[k].lo, box[k].hi);
+  for (std::size_t f = 0; f < d.dynamics_forms.size() && static_cast<int>(box.size()) > lay.count(); ++f)
+    out.param_col.push_back(lp.AddColumn(box[lay.count() + f].lo, box[lay.count() + f].hi));
   auto gamma_col = [&](int k) { return out.param_col[lay.gamma_begin + k - 2]; };  // k = 2..n_gamma
   auto alpha_col = [&](int j) { return out.param_col[lay.alpha_begin + j - 2]; };  // j = 2..n_alpha
   auto a_col = [&](int i) { return out.param_col[lay.a_begin + i - 1]; };          // i = 1..na
@@ -234,6 +238,41 @@ LiftedLp BuildLiftedLp(const LiftedData& d, const ParamBox& box, Window window, 
       row.Add(w, 1.0).Add(a, -ph[0]).Add(z, -u);
       for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], -ph[j - 1]).Add(alpha_col(j), Interval(u) * ph[j - 1]);
       row.AtLeast(-(Interval(u) * ph[0]));
+    }
+  }
+  // The forms f = sum_i c_i a_i of the box: (f - l)(z - pL) >= 0 and its three siblings, with f z_tau =
+  // sum_i c_i w_{i,tau} and f p(alpha, .) = sum_i c_i (a_i phi_1 + sum_j c_ij phi_j); only where every w_{i,tau}
+  // of the form exists (fewer rows stay a valid relaxation).
+  for (std::size_t f = 0; f < d.dynamics_forms.size() && static_cast<int>(box.size()) > lay.count(); ++f) {
+    const DynamicsForm& form = d.dynamics_forms[f];
+    const int fc = out.param_col[lay.count() + f];
+    row.Add(fc, 1.0);
+    for (int i = 1; i <= na; ++i)
+      if (form[i - 1] != 0.0) row.Add(a_col(i), -form[i - 1]);
+    row.EqualTo(0.0);
+    const double l = box[lay.count() + f].lo, u = box[lay.count() + f].hi;
+    for (int tau = window.begin; tau < window.end; ++tau) {
+      bool all = true;
+      for (int i = 1; i <= na; ++i) all = all && (form[i - 1] == 0.0 || w_col[i][tau - window.begin] >= 0);
+      if (!all) continue;
+      const int z = z_col(tau);
+      // side: +1 for (f - l)(...), -1 for (u - f)(...); band: the factor (z - pL) or (pH - z).
+      for (const auto& [edge, side] : {std::pair{l, 1.0}, std::pair{u, -1.0}})
+        for (const auto* band : {&d.phi_lo[tau], &d.phi_hi[tau]}) {
+          const double zsign = band == &d.phi_lo[tau] ? 1.0 : -1.0;  // z - pL, or pH - z
+          const auto& ph = *band;
+          const double k = side * zsign;  // the sign of f * z in the product
+          for (int i = 1; i <= na; ++i) {
+            if (form[i - 1] == 0.0) continue;
+            row.Add(w_col[i][tau - window.begin], k * form[i - 1]);
+            row.Add(a_col(i), -k * (Interval(form[i - 1]) * ph[0]));
+            for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], -k * (Interval(form[i - 1]) * ph[j - 1]));
+          }
+          // -side * edge * (z - p) for band lo, i.e. the edge times the band factor.
+          row.Add(z, -k * edge);
+          for (int j = 2; j <= n_alpha; ++j) row.Add(alpha_col(j), k * (Interval(edge) * ph[j - 1]));
+          row.AtLeast(-k * (Interval(edge) * ph[0]));
+        }
     }
   }
   // Envelopes of c_ij = a_i alpha_j and beta_jk = b_j gamma_k.

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "dss/hw_outer_set.hpp"
+#include "exact/dynamics_forms.hpp"
 #include "exact/interval.hpp"
 #include "exact/lp_problem.hpp"
 
@@ -37,13 +38,14 @@ struct LiftedData {
   std::vector<std::vector<Interval>> psi;            // [t][k]: psi_k(u_t)
   std::vector<std::vector<Interval>> phi_grid;       // [m][j]: phi_j at the monotonicity grid's points
   std::vector<double> grid;                          // the grid over [min L_t, max H_t]
+  std::vector<DynamicsForm> dynamics_forms;          // extra factors of the products (exact/dynamics_forms.hpp)
   int first_lag() const { return structure.strictly_proper ? 1 : 0; }
 };
 // Checks the structure and data (throws hw::InputError with the sample's place for a non-finite value).
 LiftedData MakeLiftedData(const dss::HwStructure& structure, const dss::HwData& data, int grid_points = 64);
 
-// A box of the parameters in the layout's order [gamma_2.., alpha_2.., a_1..a_na, b_j0..b_nb].
-using ParamBox = std::vector<Interval>;
+// A box of the parameters in the layout's order [gamma_2.., alpha_2.., a_1..a_na, b_j0..b_nb], then (optional)
+// the ranges of data.dynamics_forms (exact/dynamics_forms.hpp).
 
 struct Window {
   int begin = 0, end = 0;  // samples [begin, end)
@@ -57,7 +59,7 @@ struct LiftedLp {
   LpProblem lp;
   Window window;
   int s_col = -1;
-  std::vector<int> param_col;   // per layout parameter (gamma_k, alpha_j, a_i, b_j = beta_j1)
+  std::vector<int> param_col;   // per box entry (gamma_k, alpha_j, a_i, b_j = beta_j1, then the forms)
   std::vector<int> z_col;       // per sample of the window (index t - window.begin)
   int num_equations = 0;
   // Sets the objective to minimise sum_k weight_k * parameter_k (0 elsewhere); the feasibility form minimises s.

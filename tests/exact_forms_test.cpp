@@ -1,0 +1,148 @@
+// Forms of the dynamics (exact/dynamics_forms.hpp): thin directions from points, the propagation between form
+// and axis ranges, the lifted LP's rows for a form range, and soundness of whole runs that use forms.
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "exact/branch_and_bound.hpp"
+#include "exact/clp_solver.hpp"
+#include "exact/dynamics_forms.hpp"
+#include "exact/exact_bounds.hpp"
+#include "exact/membership.hpp"
+#include "random_hw.hpp"
+
+namespace hw::exact {
+namespace {
+
+// A random instance of exactly n samples with na = 2.
+testing::RandomHwInstance SecondOrderInstance(uint64_t first_seed, int samples) {
+  testing::RandomHwOptions opts;
+  opts.min_samples = samples, opts.max_samples = samples;
+  for (uint64_t seed = first_seed;; ++seed) {
+    auto inst = testing::MakeRandomHwInstance(seed, opts);
+    if (inst.structure.na == 2) return inst;
+  }
+}
+
+ParamBox BoxAround(const LiftedData& d, const std::vector<double>& theta, double a_width, double other_width) {
+  ParamBox box;
+  for (int k = 0; k < d.layout.count(); ++k) {
+    const bool is_a = k >= d.layout.a_begin && k < d.layout.a_begin + d.structure.na;
+    box.emplace_back(theta[k] - (is_a ? a_width : other_width), theta[k] + (is_a ? a_width : other_width));
+  }
+  return box;
+}
+
+TEST(DynamicsForms, ThePointsThinDirectionIsFoundAndAnIsotropicCloudHasNone) {
+  const auto inst = SecondOrderInstance(1, 40);
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  const int a0 = d.layout.a_begin;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<std::vector<double>> strip, cloud;
+  for (int p = 0; p < 12; ++p) {
+    std::vector<double> theta = inst.theta;
+    const double along = n(rng) * 1e-3, across = n(rng) * 1e-5;  // a strip along (1, 1)
+    theta[a0] += along + across;
+    theta[a0 + 1] += along - across;
+    strip.push_back(theta);
+    theta = inst.theta;
+    theta[a0] += n(rng) * 1e-3;
+    theta[a0 + 1] += n(rng) * 1e-3;
+    cloud.push_back(theta);
+  }
+  const auto forms = ThinDirections(d, strip);
+  ASSERT_EQ(forms.size(), 1u);
+  EXPECT_EQ(forms[0][0], 1.0);
+  EXPECT_NEAR(forms[0][1], -1.0, 0.02);  // twelve points estimate the direction
+  EXPECT_TRUE(ThinDirections(d, cloud).empty());
+  EXPECT_TRUE(ThinDirections(d, {strip[0], strip[1]}).empty());  // too few points
+}
+
+TEST(DynamicsForms, PropagationNarrowsBothWaysAndKeepsEveryPointOfBoth) {
+  const auto inst = SecondOrderInstance(2, 40);
+  LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  d.dynamics_forms = {{1.0, -1.0}};
+  const int a0 = d.layout.a_begin, f = d.layout.count();
+  ParamBox box(d.layout.count(), Interval(0.0, 1.0));
+  box[a0] = Interval(1.0, 2.0);
+  box[a0 + 1] = Interval(0.5, 1.0);
+  box = WithFormRanges(d, box);
+  EXPECT_LE(box[f].lo, 0.0);
+  EXPECT_GE(box[f].hi, 1.5);
+  box[f] = Interval(0.9, 1.0);  // a1 - a2 in [0.9, 1]: a1 <= 2.0 and a1 >= 1.4
+  PropagateForms(d, box);
+  EXPECT_NEAR(box[a0].lo, 1.4, 1e-12);
+  EXPECT_LE(box[a0].lo, 1.4);
+  EXPECT_NEAR(box[a0].hi, 2.0, 1e-12);
+  EXPECT_NEAR(box[a0 + 1].hi, 1.0, 1e-12);
+  // Every pair with a1 - a2 in the form range and both in the old box is still inside.
+  for (double a1 = 1.0; a1 <= 2.0; a1 += 0.01)
+    for (double a2 = 0.5; a2 <= 1.0; a2 += 0.01)
+      if (a1 - a2 >= 0.9 && a1 - a2 <= 1.0) {
+        EXPECT_TRUE(box[a0].contains(a1)) << a1;
+        EXPECT_TRUE(box[a0 + 1].contains(a2)) << a2;
+      }
+}
+
+TEST(DynamicsForms, AFormRangeAroundTheTruthIsKeptAndOneBesideItIsPruned) {
+  const auto inst = SecondOrderInstance(3, 80);
+  LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  d.dynamics_forms = {{1.0, -1.0}};
+  const int a0 = d.layout.a_begin, f = d.layout.count();
+  const double truth = inst.theta[a0] - inst.theta[a0 + 1];
+  ClpSolver clp;
+  BoxEvaluationOptions ev;
+  ev.cheap_window = 0;
+  ParamBox box = WithFormRanges(d, BoxAround(d, inst.theta, 0.05, 0.5));
+  box[f] = Interval(truth - 1e-6, truth + 1e-6);  // a thin range: the form rows are tight around the truth
+  PropagateForms(d, box);
+  EXPECT_EQ(TestBoxEmpty(d, box, ev, clp).verdict, BoxVerdict::kKept) << inst.description;
+  box[f] = Interval(truth + 0.04, truth + 0.05);  // inside the axis box, far from D
+  const BoxEvaluation e = TestBoxEmpty(d, box, ev, clp);
+  EXPECT_EQ(e.verdict, BoxVerdict::kPruned) << inst.description;
+}
+
+// Whole runs with forms (a generous thin share, so most second- and third-order systems get one): the truth and
+// independently found points of D stay inside every interval.
+TEST(DynamicsForms, RunsWithFormsContainTheTruthAndIndependentMembers) {
+  int with_forms = 0, members = 0;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> step(0.0, 1.0);
+  ClpSolver clp;
+  for (uint64_t seed = 201; seed < 221; ++seed) {
+    testing::RandomHwOptions opts;
+    opts.min_samples = 40, opts.max_samples = 70;
+    const auto inst = testing::MakeRandomHwInstance(seed, opts);
+    const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+    const ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
+    ExactBoundsOptions o;
+    o.executor = std::make_shared<sdp::InProcessExecutor>();
+    o.prune.max_levels = 4;
+    o.search.lp_budget = 4;
+    o.sweeps = 2;
+    o.evaluation.cheap_window = 0;
+    o.forms.thin_share = 0.95;
+    const ExactBoundsSummary s = ComputeExactBounds(o, inst.structure, inst.data, start);
+    ASSERT_FALSE(s.invalidated) << inst.description;
+    with_forms += !s.dynamics_forms.empty();
+    std::vector<std::vector<double>> points = {inst.theta};
+    for (int trial = 0; trial < 8; ++trial) {
+      std::vector<double> p = inst.theta;
+      for (double& v : p) v += 1e-3 * step(rng) * std::max(1.0, std::abs(v));
+      if (CheckMembership(d, p, clp).member) points.push_back(p);
+    }
+    members += static_cast<int>(points.size());
+    for (const auto& p : points)
+      for (int k = 0; k < d.layout.count(); ++k) {
+        if (!start[k].contains(p[k])) continue;
+        EXPECT_LE(s.intervals[k].lower.value, p[k]) << inst.description << " " << d.layout.names[k];
+        EXPECT_GE(s.intervals[k].upper.value, p[k]) << inst.description << " " << d.layout.names[k];
+      }
+  }
+  EXPECT_GE(with_forms, 5);
+  EXPECT_GT(members, 20);
+}
+
+}  // namespace
+}  // namespace hw::exact
