@@ -154,6 +154,17 @@ InnerRanges InnerRangesWithForms(const LiftedData& data, const InnerHull& inner)
   return ranges;
 }
 
+// A gamma_k while no b_j of the box has a sign: bounded directly (not as beta_jk / b_j), which only narrows it
+// for the envelopes of the next sweep; a few LPs do that, the rest of the budget would buy nothing.
+constexpr int kUnsignedGammaBudget = 2;
+bool GammaWithoutDenominator(const LiftedData& data, const ParamBox& box, int k) {
+  const auto& lay = data.layout;
+  if (k < lay.gamma_begin || k >= lay.gamma_begin + lay.num_gamma) return false;
+  for (int j = lay.b_begin; j < lay.count(); ++j)
+    if (box[j].lo > 0 || box[j].hi < 0) return false;
+  return true;
+}
+
 // Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter and form)
 // refined. The forms' new ranges go to `form_ranges`.
 void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
@@ -174,7 +185,9 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
         gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
       }
       objectives.push_back({k, maximise});
-      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms));
+      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms,
+                                       GammaWithoutDenominator(data, start, k) ? std::optional<int>(kUnsignedGammaBudget)
+                                                                               : std::nullopt));
     }
   const auto answers = runner.Run(specs, on_done);
   for (std::size_t o = 0; o < objectives.size(); ++o) {
@@ -386,6 +399,13 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     with_forms.dynamics_forms = ThinDirections(lifted, points, options.forms);
   }
   s.dynamics_forms = with_forms.dynamics_forms;
+  if (!with_forms.dynamics_forms.empty()) {  // the bounding LPs' shape, forms included
+    const LiftedLp shape =
+        BuildLiftedLp(with_forms, WithFormRanges(with_forms, proven), WholeRecord(lifted), LiftedForm::kFeasibility);
+    s.lp_rows = shape.lp.num_rows();
+    s.lp_cols = shape.lp.num_cols();
+    s.lp_nonzeros = static_cast<long>(shape.lp.entries.size());
+  }
   std::optional<InnerRanges> inner_ranges;
   if (inner) inner_ranges = InnerRangesWithForms(with_forms, *inner);
 

@@ -58,13 +58,14 @@ nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool c
 
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap,
-                                const std::vector<DynamicsForm>& forms) {
+                                const std::vector<DynamicsForm>& forms, std::optional<int> lp_budget) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& b : boxes) list.push_back(BoxToJson(b));
   nlohmann::json j = {{"kind", kObjectiveKind}, {"start", BoxToJson(start)}, {"boxes", list},
                       {"parameter", objective.parameter}, {"maximise", objective.maximise}, {"target_gap", target_gap}};
   j["target"] = target ? nlohmann::json(*target) : nlohmann::json(nullptr);
   if (!forms.empty()) j["forms"] = FormsToJson(forms);
+  if (lp_budget) j["lp_budget"] = *lp_budget;
   return j;
 }
 
@@ -98,6 +99,8 @@ sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSett
     const Objective objective{spec.at("parameter").get<int>(), spec.at("maximise").get<bool>()};
     std::optional<double> target;
     if (!spec.at("target").is_null()) target = spec.at("target").get<double>();
+    ObjectiveSearchOptions search = settings.search;
+    if (spec.contains("lp_budget")) search.lp_budget = spec.at("lp_budget").get<int>();
     // The forms travel in the spec: an MPI rank's data has none of the coordinator's.
     LiftedData with_forms;
     if (spec.contains("forms")) {
@@ -106,7 +109,7 @@ sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSett
     }
     const ObjectiveSearchResult r =
         SearchObjective(spec.contains("forms") ? with_forms : data, BoxFromJson(spec.at("start")), boxes, objective,
-                        target, spec.at("target_gap").get<double>(), settings.search, settings.evaluation, *solver);
+                        target, spec.at("target_gap").get<double>(), search, settings.evaluation, *solver);
     return r.to_json().dump();
   };
 }

@@ -22,7 +22,8 @@ struct ExactJobSettings {
 nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool cheap_windows);
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap,
-                                const std::vector<DynamicsForm>& forms = {});
+                                const std::vector<DynamicsForm>& forms = {},
+                                std::optional<int> lp_budget = std::nullopt);  // default: the settings' budget
 
 // Answers either kind of spec (called in the worker process).
 sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSettings& settings);

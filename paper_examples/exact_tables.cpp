@@ -182,6 +182,7 @@ int main(int argc, char** argv) {
   std::string split = exact::ToString(exact::ObjectiveSearchOptions{}.split);
   int samples = 0;
   bool rotate = exact::ObjectiveSearchOptions{}.rotate_denominators;
+  std::string run_dir;
   std::vector<std::string> summarise;
   std::string summary_out;
   app.add_option("--tables", tables, "a committed cerone_tables result (tables.json) with an n = 2 case");
@@ -205,6 +206,7 @@ int main(int argc, char** argv) {
         exact::EndpointSplit parsed;
         return exact::ParseEndpointSplit(name, &parsed) ? std::string() : "expected dynamics or alternate";
       });
+  app.add_option("--run-dir", run_dir, "keep the jobs' answers here; a rerun (or a run with more sweeps) reads them");
   app.add_option("--rotate-denominators", rotate, "gamma through each b_j of one sign in turn (true/false)");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -233,6 +235,7 @@ int main(int argc, char** argv) {
     options.search.lp_budget = lp_budget;
     exact::ParseEndpointSplit(split, &options.search.split);
     options.search.rotate_denominators = rotate;
+    options.run_dir = run_dir;
     options.sweeps = sweeps;
     options.lp_solver = lp_solver;
     const auto s = exact::ComputeExactBounds(options, dss::CeroneExampleStructure(), data, one.box,
