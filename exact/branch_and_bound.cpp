@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 namespace hw::exact {
 
@@ -21,12 +22,15 @@ int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& 
   return best;
 }
 
-std::pair<ParamBox, ParamBox> HalveBox(const ParamBox& box, int parameter) {
+std::pair<ParamBox, ParamBox> CutBox(const ParamBox& box, int parameter, double cut) {
   ParamBox lower = box, upper = box;
-  const double mid = box[parameter].mid();
-  lower[parameter].hi = mid;
-  upper[parameter].lo = mid;
+  lower[parameter].hi = cut;
+  upper[parameter].lo = cut;
   return {lower, upper};
+}
+
+std::pair<ParamBox, ParamBox> HalveBox(const ParamBox& box, int parameter) {
+  return CutBox(box, parameter, box[parameter].mid());
 }
 
 ParamBox HullOf(const std::vector<ParamBox>& boxes) {
@@ -202,8 +206,7 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
                                      : box.box[k].mid();
     SearchBox a = box, b = box;
     a.evaluated = b.evaluated = false;
-    a.box[k].hi = cut;
-    b.box[k].lo = cut;
+    std::tie(a.box, b.box) = CutBox(box.box, k, cut);
     for (SearchBox* c : {&a, &b}) {
       PropagateForms(data, c->box);
       (cut_objective ? c->objective_splits : c->dynamics_splits) += 1;

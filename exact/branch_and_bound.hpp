@@ -21,6 +21,8 @@ namespace hw::exact {
 
 // The index (in the layout) of the a_i to halve: the widest relative to the start box's width.
 int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& start);
+// The box cut in two at `cut` along one parameter; HalveBox cuts at the middle.
+std::pair<ParamBox, ParamBox> CutBox(const ParamBox& box, int parameter, double cut);
 std::pair<ParamBox, ParamBox> HalveBox(const ParamBox& box, int parameter);
 // The hull of boxes (per parameter).
 ParamBox HullOf(const std::vector<ParamBox>& boxes);

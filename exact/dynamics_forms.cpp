@@ -64,6 +64,12 @@ std::vector<DynamicsForm> ThinDirections(const LiftedData& data, const std::vect
   return forms;
 }
 
+double FormValue(const LiftedData& data, const DynamicsForm& form, const std::vector<double>& theta) {
+  double v = 0.0;
+  for (std::size_t i = 0; i < form.size(); ++i) v += form[i] * theta[data.layout.a_begin + i];
+  return v;
+}
+
 Interval FormRange(const LiftedData& data, const DynamicsForm& form, const ParamBox& box) {
   Interval r(0.0);
   for (std::size_t i = 0; i < form.size(); ++i) r += box[data.layout.a_begin + i] * form[i];

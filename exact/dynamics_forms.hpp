@@ -36,6 +36,8 @@ struct DynamicsFormOptions {
 std::vector<DynamicsForm> ThinDirections(const LiftedData& data, const std::vector<std::vector<double>>& points,
                                          const DynamicsFormOptions& options = {});
 
+// The form's value at a point (layout order).
+double FormValue(const LiftedData& data, const DynamicsForm& form, const std::vector<double>& theta);
 // The range of a form over the a-entries of a box (interval arithmetic: contains every value).
 Interval FormRange(const LiftedData& data, const DynamicsForm& form, const ParamBox& box);
 // The box with the forms' ranges appended (a box that already has them is returned as it is).

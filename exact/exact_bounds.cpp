@@ -141,12 +141,10 @@ using InnerRanges = std::vector<std::optional<std::pair<double, double>>>;
 // The inner hull's ranges for every entry of a box with forms: the parameters', then each form's over the points.
 InnerRanges InnerRangesWithForms(const LiftedData& data, const InnerHull& inner) {
   InnerRanges ranges = inner.ranges;
-  const int a0 = data.layout.a_begin;
   for (const auto& form : data.dynamics_forms) {
     std::optional<std::pair<double, double>> r;
     for (const auto& p : inner.points) {
-      double v = 0.0;
-      for (std::size_t i = 0; i < form.size(); ++i) v += form[i] * p.theta[a0 + i];
+      const double v = FormValue(data, form, p.theta);
       r = r ? std::pair{std::min(r->first, v), std::max(r->second, v)} : std::pair{v, v};
     }
     ranges.push_back(r);
