@@ -3,6 +3,7 @@
 // a share of its width around the inner hull's point extreme in that endpoint: the entry whose narrowing moves
 // the bound most is the one a branch and bound should split for it.
 //   exact_endpoint_probe --result paper_examples/results/exact_snr31_seed1/exact.json --parameter gamma2 --max
+#include <chrono>
 #include <fstream>
 
 #include <CLI/CLI.hpp>
@@ -30,6 +31,9 @@ int main(int argc, char** argv) {
   app.add_option("--share", share, "each narrowed range keeps this share of its width")->check(CLI::Range(1e-6, 1.0));
   app.add_option("--lp-solver", solver_name);
   app.add_option("--gamma-ratio", ratio_name);
+  bool bound_only = false, start_box = false;
+  app.add_flag("--start-box", start_box, "the run's start box (the D^ss box) instead of the box it proved");
+  app.add_flag("--bound-only", bound_only, "the whole box's bound only (no narrowing)");
   CLI11_PARSE(app, argc, argv);
   std::ifstream in(result_path);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -40,7 +44,10 @@ int main(int argc, char** argv) {
   auto lifted = ex::MakeLiftedData(hw::dss::CeroneExampleStructure(), data);
   lifted.dynamics_forms = ex::FormsFromJson(j.at("stage2").at("dynamics_forms"));
   ex::ParamBox box;
-  for (const auto& iv : j.at("intervals")) box.emplace_back(iv.at("lower").at("value"), iv.at("upper").at("value"));
+  if (start_box)
+    for (const auto& iv : j.at("start_box")) box.emplace_back(iv.at(0).get<double>(), iv.at(1).get<double>());
+  else
+    for (const auto& iv : j.at("intervals")) box.emplace_back(iv.at("lower").at("value"), iv.at("upper").at("value"));
   const auto& names = lifted.layout.names;
   const int p = static_cast<int>(std::find(names.begin(), names.end(), parameter) - names.begin());
   if (p >= lifted.layout.count()) throw std::invalid_argument("unknown parameter " + parameter);
@@ -62,8 +69,11 @@ int main(int argc, char** argv) {
     const auto e = ex::BoundObjective(lifted, b, objective, options, *solver, {}, ratio);
     return std::pair{e.bound ? *e.bound : NAN, e.lps};
   };
+  const auto t0 = std::chrono::steady_clock::now();
   const auto [b0, lps0] = bound_on(box);
-  fmt::print("whole box: bound {:.7f} (gap to inner {:.3g}, {} LPs)\n", b0, std::abs(b0 - extreme[p]), lps0);
+  fmt::print("whole box: bound {:.7f} (gap to inner {:.3g}, {} LPs, {:.2f} s)\n", b0, std::abs(b0 - extreme[p]), lps0,
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (bound_only) return 0;
   std::vector<double> at = extreme;
   for (const auto& f : lifted.dynamics_forms) at.push_back(ex::FormValue(lifted, f, extreme));
   auto narrowed = [&](ex::ParamBox b, int k) {
