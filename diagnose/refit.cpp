@@ -461,6 +461,20 @@ bool SearchOffsetUnderOutputQuantizer(AugmentedModel* m, const Segment& s, const
   return true;
 }
 
+// The other numbers under an output quantizer (linear block, maps, offset, initial state) see a cost
+// that is piecewise constant, so LM from the nominal's values barely moves them, and a quantizer with the
+// right step then mispredicts new data. They are refitted by continuation: LM with the rounding smoothed
+// over a quarter and then a tenth of a step, then the exact staircase; kept when the exact cost drops.
+void RefitUnderSmoothedOutputQuantizer(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  AugmentedModel t = *m;
+  for (double width : {0.25, 0.1}) {
+    t.output_quantizer_smoothing = width;
+    Lm(&t, Packing::For(t, o), s, o.lm);
+  }
+  t.output_quantizer_smoothing = 0.0;
+  if (SumSquaredError(t, s) < SumSquaredError(*m, s)) *m = t;
+}
+
 // Whether the cost is flat around parameter i of block b (1 % either side): a smooth parameter between
 // two levels of a piecewise-constant signal, which LM cannot move.
 bool FlatAround(const AugmentedModel& m, std::size_t b, std::size_t i, const Segment& s) {
@@ -477,17 +491,27 @@ bool FlatAround(const AugmentedModel& m, std::size_t b, std::size_t i, const Seg
 
 // Local search of every search-only parameter (and of smooth ones on a flat cost), centred in the run
 // of tied values and repeated while that run reaches the end of the local values; then LM again.
-void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
-  bool any = false;
+void SearchBlockParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o, bool* any) {
   for (std::size_t b = 0; b < m->blocks.size(); ++b)
     for (std::size_t i = 0; i < m->blocks[b].params.size(); ++i) {
       const bool smooth = ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i));
       if (smooth && !FlatAround(*m, b, i, s)) continue;
-      any = true;
+      *any = true;
       for (int pass = 0; pass < 3; ++pass)
         if (!CentreInTies(m, b, i, LocalValues(m->blocks[b], static_cast<int>(i)), s, o)) break;
     }
-  if (SearchOffsetUnderOutputQuantizer(m, s, o)) any = true;
+}
+
+// Under an output quantizer, the offset search and the smoothed refit move the numbers the quantizer's
+// step and grid offset were searched with: those are searched once more.
+void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  bool any = false;
+  SearchBlockParameters(m, s, o, &any);
+  if (SearchOffsetUnderOutputQuantizer(m, s, o)) {
+    RefitUnderSmoothedOutputQuantizer(m, s, o);
+    SearchBlockParameters(m, s, o, &any);
+    any = true;
+  }
   if (any) Lm(m, Packing::For(*m, o), s, o.lm);
 }
 
