@@ -3,12 +3,31 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include <fmt/format.h>
 
 #include "exact/safe_bound.hpp"
 
 namespace hw::exact {
+std::string ToString(GammaRatio ratio) {
+  switch (ratio) {
+    case GammaRatio::kLargest: return "largest";
+    case GammaRatio::kRotate: return "rotate";
+    case GammaRatio::kPooled: return "pooled";
+  }
+  return "largest";
+}
+
+bool ParseGammaRatio(const std::string& text, GammaRatio* ratio) {
+  for (GammaRatio r : {GammaRatio::kLargest, GammaRatio::kRotate, GammaRatio::kPooled})
+    if (text == ToString(r)) {
+      *ratio = r;
+      return true;
+    }
+  return false;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -50,20 +69,22 @@ std::vector<double> ParameterValues(const LiftedLp& lifted, const std::vector<do
   return p;
 }
 
-// The b_j (index into beta_col) of one sign over the box: the turn-th farthest from zero (cyclically), or -1.
-// gamma_k = beta_jk / b_j for every such j, but the relaxation leaves the beta_jk of different j free of each
-// other, so each ratio bounds gamma_k differently; boxes of a search take them in turn and keep the tightest.
-int RatioDenominator(const LiftedData& data, const ParamBox& box, int turn) {
+// The ratio's terms (index into beta_col, sign of b_j) over the b_j of one sign on the box; empty when none has.
+std::vector<std::pair<int, double>> RatioTerms(const LiftedData& data, const ParamBox& box, GammaRatio ratio,
+                                               int turn) {
   const auto& lay = data.layout;
-  std::vector<std::pair<double, int>> signed_b;  // (-margin, j): farthest first, then by index
+  std::vector<std::tuple<double, int, double>> signed_b;  // (-margin, j, sign): farthest first, then by index
   for (int j = 0; lay.b_begin + j < lay.count(); ++j) {
     const Interval b = box[lay.b_begin + j];
     const double margin = b.lo > 0 ? b.lo : (b.hi < 0 ? -b.hi : 0.0);
-    if (margin > 0.0) signed_b.emplace_back(-margin, j);
+    if (margin > 0.0) signed_b.emplace_back(-margin, j, b.lo > 0 ? 1.0 : -1.0);
   }
-  if (signed_b.empty()) return -1;
   std::sort(signed_b.begin(), signed_b.end());
-  return signed_b[static_cast<std::size_t>(turn) % signed_b.size()].second;
+  std::vector<std::pair<int, double>> terms;
+  for (const auto& [margin, j, sign] : signed_b) terms.emplace_back(j, sign);
+  if (terms.empty() || ratio == GammaRatio::kPooled) return terms;
+  const std::size_t pick = ratio == GammaRatio::kRotate ? static_cast<std::size_t>(turn) % terms.size() : 0;
+  return {terms[pick]};
 }
 
 }  // namespace
@@ -153,7 +174,7 @@ bool Usable(const BoundSolve& s) { return s.result.status == LpStatus::kOptimal 
 
 BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
                              const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm,
-                             int denominator_turn) {
+                             GammaRatio ratio, int turn) {
   const auto start = Clock::now();
   const auto& lay = data.layout;
   const double sign = objective.maximise ? -1.0 : 1.0;  // every LP minimises sign * objective
@@ -168,8 +189,9 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     return empty;
   };
   const bool is_gamma = objective.parameter >= lay.gamma_begin && objective.parameter < lay.gamma_begin + lay.num_gamma;
-  const int ratio_j = is_gamma ? RatioDenominator(data, box, denominator_turn) : -1;
-  if (ratio_j < 0) {
+  const std::vector<std::pair<int, double>> terms =
+      is_gamma ? RatioTerms(data, box, ratio, turn) : std::vector<std::pair<int, double>>{};
+  if (terms.empty()) {
     std::vector<double> weights(lifted.param_col.size(), 0.0);
     weights[objective.parameter] = sign;
     lifted.SetParameterObjective(weights);
@@ -184,20 +206,25 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     out.point = ParameterValues(lifted, s.result.primal);
     out.basis = s.result.basis;
   } else {
-    // gamma_k = beta_jk / b_j with b_j of one sign: Dinkelbach steps g <- beta*/b*, then the certificate
-    // min sigma*sign*(beta_jk - g b_j) >= m  =>  gamma_k >= g + m / b (the b end chosen by the sign of m).
+    // gamma_k = (sum_j s_j beta_jk) / |B| with B = sum_j s_j b_j, s_j the sign of b_j: Dinkelbach steps
+    // g <- ratio at the LP's optimum, then the certificate min sign*(sum_j s_j (beta_jk - g b_j)) >= m  =>
+    // sign*gamma_k >= sign*g + m / |B| (the |B| end chosen by the sign of m).
     const int k = objective.parameter - lay.gamma_begin + 1;  // beta column index (0 is b_j)
-    const Interval b = box[lay.b_begin + ratio_j];
-    const double sigma = b.lo > 0 ? 1.0 : -1.0;
-    const double b_near = sigma > 0 ? b.lo : -b.hi, b_far = sigma > 0 ? b.hi : -b.lo;  // |b| range, > 0
+    auto signed_b = [&](const std::pair<int, double>& term) {
+      const Interval b = box[lay.b_begin + term.first];
+      return term.second > 0 ? b : -b;
+    };
+    Interval abs_b = signed_b(terms.front());  // |B| over the box, > 0 (one term: exact, no rounding)
+    for (std::size_t t = 1; t < terms.size(); ++t) abs_b += signed_b(terms[t]);
+    const double b_near = abs_b.lo, b_far = abs_b.hi;
     double g = box[objective.parameter].mid();
     LpBasis basis = warm;
     std::optional<double> best;
     LpSolveOptions lp = options.lp;  // a gap m in the objective moves the gamma bound by m / |b|
     lp.acceptable_gap = AcceptableGap(options.lp, box[objective.parameter]) * b_near;
     for (int step = 0; step < 8; ++step) {
-      lifted.SetRatioObjective(ratio_j, k, g);
-      for (double& c : lifted.lp.obj) c *= sigma * sign;
+      lifted.SetRatioObjective(terms, k, g);
+      for (double& c : lifted.lp.obj) c *= sign;
       BoundSolve s = SolveBound(lifted, solver, basis, lp);
       ++out.lps;
       if (s.result.status != LpStatus::kOptimal) ++out.lp_failures;
@@ -216,7 +243,11 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
       const double signed_bound = (Interval(sign * g) + Interval(m) * inv).lo;
       const double candidate = sign * signed_bound;
       if (!best || (objective.maximise ? candidate < *best : candidate > *best)) best = candidate;
-      const double beta = s.result.primal[lifted.beta_col[ratio_j][k]], bj = s.result.primal[lifted.beta_col[ratio_j][0]];
+      double beta = 0.0, bj = 0.0;
+      for (const auto& [j, s_j] : terms) {
+        beta += s_j * s.result.primal[lifted.beta_col[j][k]];
+        bj += s_j * s.result.primal[lifted.beta_col[j][0]];
+      }
       out.lp_value = beta / bj;
       const double g_next = beta / bj;
       // Converged once the ratio moves by less than a millionth of the box: a simplex returns the same vertex

@@ -41,6 +41,17 @@ struct BoxEvaluationOptions {
 
 enum class BoxVerdict { kPruned, kKept };
 
+// How a gamma_k is bounded once b_j of one sign exist: gamma_k = beta_jk / b_j for each such j, and as well
+// gamma_k = (sum_j s_j beta_jk) / (sum_j s_j b_j) with s_j the sign of b_j. The relaxation leaves the beta_jk of
+// different j free of each other, so the ratios bound gamma_k differently.
+enum class GammaRatio {
+  kLargest,  // beta_jk / b_j with the b_j farthest from zero
+  kRotate,   // each b_j of one sign in turn (by the box's depth); a search keeps the tightest
+  kPooled,   // all b_j of one sign at once: the LP cannot push each ratio to its own extreme
+};
+std::string ToString(GammaRatio ratio);
+bool ParseGammaRatio(const std::string& text, GammaRatio* ratio);
+
 struct BoxEvaluation {
   BoxVerdict verdict = BoxVerdict::kKept;
   std::optional<PruneCertificate> certificate;  // with kPruned
@@ -58,10 +69,11 @@ BoxEvaluation TestBoxEmpty(const LiftedData& data, const ParamBox& box, const Bo
                            LpSolver& solver, const LpBasis& warm = {});
 // The objective's rigorous bound over the box (min: a lower bound; max: an upper bound). An infeasible LP
 // leads to the emptiness test on the whole record.
-// `denominator_turn` picks which b_j of one sign divides a gamma (the farthest from zero first, cyclically).
+// A gamma_k is bounded as a ratio once some b_j has a sign over the box: `ratio` says which ratio, `turn` which
+// b_j (with GammaRatio::kRotate: the farthest from zero first, cyclically).
 BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
                              const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm = {},
-                             int denominator_turn = 0);
+                             GammaRatio ratio = GammaRatio::kLargest, int turn = 0);
 
 // The whole record as a window.
 Window WholeRecord(const LiftedData& data);

@@ -22,6 +22,44 @@ int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& 
   return best;
 }
 
+namespace {
+
+// The entries an endpoint of parameter p halves with EndpointSplit::kFamily: the a_i, the forms, and p's family.
+std::vector<int> FamilyEntries(const LiftedData& data, int p, std::size_t box_size) {
+  const auto& lay = data.layout;
+  auto in = [](int k, int begin, int count) { return k >= begin && k < begin + count; };
+  const int nb = lay.count() - lay.b_begin;
+  std::vector<int> entries;
+  auto add = [&](int begin, int count) {
+    for (int k = begin; k < begin + count; ++k) entries.push_back(k);
+  };
+  add(lay.count(), static_cast<int>(box_size) - lay.count());  // forms first: on a tie the cut across D's strip
+  add(lay.a_begin, data.structure.na);
+  if (in(p, lay.gamma_begin, lay.num_gamma)) add(lay.gamma_begin, lay.num_gamma);
+  if (in(p, lay.alpha_begin, lay.num_alpha) || in(p, lay.b_begin, nb)) {
+    add(lay.alpha_begin, lay.num_alpha);
+    add(lay.b_begin, nb);
+  }
+  return entries;
+}
+
+}  // namespace
+
+int SplitEntry(const LiftedData& data, const ParamBox& box, const ParamBox& start, int p, EndpointSplit split,
+               const ParamBox* scale) {
+  if (split != EndpointSplit::kFamily) return SplitParameter(data, box, start);
+  const ParamBox& reference = scale && scale->size() == box.size() ? *scale : start;
+  int best = -1;
+  double best_ratio = -1.0;
+  for (int k : FamilyEntries(data, p, std::min(box.size(), start.size()))) {
+    // A point-like extent (one inner point) counts as a millionth of the start's width.
+    const double extent = std::max(reference[k].hi - reference[k].lo, 1e-6 * (start[k].hi - start[k].lo));
+    const double ratio = (box[k].hi - box[k].lo) / extent;
+    if (ratio > best_ratio) best_ratio = ratio, best = k;
+  }
+  return best;
+}
+
 std::pair<ParamBox, ParamBox> CutBox(const ParamBox& box, int parameter, double cut) {
   ParamBox lower = box, upper = box;
   lower[parameter].hi = cut;
@@ -64,12 +102,13 @@ std::string ToString(EndpointSplit split) {
   switch (split) {
     case EndpointSplit::kDynamics: return "dynamics";
     case EndpointSplit::kAlternate: return "alternate";
+    case EndpointSplit::kFamily: return "family";
   }
   return "dynamics";
 }
 
 bool ParseEndpointSplit(const std::string& text, EndpointSplit* split) {
-  for (EndpointSplit s : {EndpointSplit::kDynamics, EndpointSplit::kAlternate})
+  for (EndpointSplit s : {EndpointSplit::kDynamics, EndpointSplit::kAlternate, EndpointSplit::kFamily})
     if (text == ToString(s)) {
       *split = s;
       return true;
@@ -149,7 +188,7 @@ double ObjectiveCut(Interval range, bool maximise, std::optional<double> target,
 ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
                                       const Objective& objective, std::optional<double> target, double target_gap,
                                       const ObjectiveSearchOptions& options, const BoxEvaluationOptions& evaluation,
-                                      LpSolver& solver) {
+                                      LpSolver& solver, const ParamBox* scale) {
   const auto t0 = std::chrono::steady_clock::now();
   const double sign = objective.maximise ? -1.0 : 1.0;
   const int p = objective.parameter;
@@ -167,9 +206,9 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
     SearchBox& box = live[w];
     if (!box.evaluated) {
       if (out.lps >= options.lp_budget) break;
-      // Children divide a gamma by the next b_j in turn: a box keeps the tighter of its own and its parent's bound.
-      const int turn = options.rotate_denominators ? box.objective_splits + box.dynamics_splits : 0;
-      BoxEvaluation e = BoundObjective(data, box.box, objective, accuracy, solver, box.basis, turn);
+      // With kRotate children divide a gamma by the next b_j: a box keeps the tighter of its own and its parent's bound.
+      const int turn = box.objective_splits + box.dynamics_splits;
+      BoxEvaluation e = BoundObjective(data, box.box, objective, accuracy, solver, box.basis, options.gamma_ratio, turn);
       out.lps += e.lps;
       out.lp_failures += e.lp_failures;
       if (e.verdict == BoxVerdict::kPruned) {
@@ -200,7 +239,7 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
         (p >= data.layout.a_begin && p < data.layout.a_begin + data.structure.na) || p >= data.layout.count();
     const bool cut_objective = options.split == EndpointSplit::kAlternate && !is_dynamics &&
                                box.objective_splits <= box.dynamics_splits;
-    const int k = cut_objective ? p : SplitParameter(data, box.box, start);
+    const int k = cut_objective ? p : SplitEntry(data, box.box, start, p, options.split, scale);
     if (box.box[k].hi - box.box[k].lo < options.min_relative_width * (start[k].hi - start[k].lo)) break;
     const double cut = cut_objective ? ObjectiveCut(box.box[p], objective.maximise, target, target_gap)
                                      : box.box[k].mid();

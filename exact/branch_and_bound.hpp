@@ -41,14 +41,21 @@ enum class EndpointSplit {
   kDynamics,   // the a_i only (the relaxation's products a_i z_{t-i} tighten)
   kAlternate,  // the a_i and the endpoint's own parameter in turn: a slab beyond the inner hull is cut off, and a
                // narrow gamma_k ties every beta_jk = b_j gamma_k (the input side's over-parametrisation)
+  kFamily,     // the a_i and forms and the entries of the endpoint's own family (exact_endpoint_probe): the gammas
+               // for a gamma, the alphas and b's for an alpha or a b; the entry widest against D's known extent
+               // (the inner hull's range; else the search's start) first
 };
 std::string ToString(EndpointSplit split);
 bool ParseEndpointSplit(const std::string& text, EndpointSplit* split);
+// The entry an endpoint of parameter p halves under `split` (kAlternate's objective cuts aside); `scale` as for
+// SearchObjective.
+int SplitEntry(const LiftedData& data, const ParamBox& box, const ParamBox& start, int p, EndpointSplit split,
+               const ParamBox* scale = nullptr);
 
 struct ObjectiveSearchOptions {
   int lp_budget = 24;              // LPs of one endpoint's refinement
   EndpointSplit split = EndpointSplit::kDynamics;
-  bool rotate_denominators = false;  // gamma through each b_j of one sign in turn (by depth), not the largest only
+  GammaRatio gamma_ratio = GammaRatio::kLargest;  // how a gamma's bound divides by the b_j (box_evaluation.hpp)
   double min_relative_width = 1e-9;  // a box narrower than this (relative to the start box) is not halved
   bool IsValid(std::string* error) const;
 };
@@ -67,11 +74,12 @@ struct ObjectiveSearchResult {
 };
 
 // `target`: a value of the objective at a known point of D (the inner hull); the search stops when the bound
-// is within `target_gap` of it. Without a target it spends its budget.
+// is within `target_gap` of it. Without a target it spends its budget. `scale` (optional): D's known extent per
+// entry (the inner hull's ranges), against which EndpointSplit::kFamily measures a box's widths.
 ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
                                       const Objective& objective, std::optional<double> target, double target_gap,
                                       const ObjectiveSearchOptions& options, const BoxEvaluationOptions& evaluation,
-                                      LpSolver& solver);
+                                      LpSolver& solver, const ParamBox* scale = nullptr);
 
 nlohmann::json BoxToJson(const ParamBox& box);
 ParamBox BoxFromJson(const nlohmann::json& j);

@@ -166,12 +166,20 @@ bool GammaWithoutDenominator(const LiftedData& data, const ParamBox& box, int k)
 // Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter and form)
 // refined. The forms' new ranges go to `form_ranges`.
 void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
-                const InnerRanges* inner, double target_ratio, JobRunner& runner, ExactBoundsSummary& s,
+                const InnerRanges* inner, double target_ratio, EndpointSplit split, JobRunner& runner,
+                ExactBoundsSummary& s,
                 std::vector<ExactInterval>& intervals, std::vector<Interval>& form_ranges, bool forms_only,
                 const std::function<void(int, int)>& on_done) {
   const auto& lay = data.layout;
   std::vector<nlohmann::json> specs;
   std::vector<Objective> objectives;
+  // D's known extent per entry (the inner hull's range, else the start's): what the family split measures against.
+  std::optional<ParamBox> scale;
+  if (inner && split == EndpointSplit::kFamily) {
+    scale = start;
+    for (std::size_t k = 0; k < start.size() && k < inner->size(); ++k)
+      if ((*inner)[k]) (*scale)[k] = Interval((*inner)[k]->first, (*inner)[k]->second);
+  }
   for (int k = forms_only ? lay.count() : 0; k < static_cast<int>(start.size()); ++k)
     for (bool maximise : {false, true}) {
       std::optional<double> target;
@@ -185,7 +193,8 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
       objectives.push_back({k, maximise});
       specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms,
                                        GammaWithoutDenominator(data, start, k) ? std::optional<int>(kUnsignedGammaBudget)
-                                                                               : std::nullopt));
+                                                                               : std::nullopt,
+                                       scale));
     }
   const auto answers = runner.Run(specs, on_done);
   for (std::size_t o = 0; o < objectives.size(); ++o) {
@@ -340,7 +349,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
                          {"lp_solver", options.lp_solver},
                          {"lp_budget", options.search.lp_budget},
                          {"split", ToString(options.search.split)},
-                         {"rotate_denominators", options.search.rotate_denominators},
+                         {"gamma_ratio", ToString(options.search.gamma_ratio)},
                          {"dynamics_forms", options.dynamics_forms ? options.forms.thin_share : 0.0},
                          {"cheap_windows", {ev.cheap_window, ev.cheap_windows}},
                          {"lp_tolerances", {ev.lp.primal_tolerance, ev.lp.dual_tolerance, ev.lp.time_limit_seconds}}};
@@ -427,7 +436,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     // costs fewer LPs than bounding every live box of the pruning search first.
     const std::vector<ParamBox> sweep_boxes = {sweep_start};
     BoundSweep(with_forms, sweep_start, sweep_boxes, inner_ranges ? &*inner_ranges : nullptr, options.target_ratio,
-               runner, s, s.intervals, form_ranges, sweep == 0, [&](int done, int total) {
+               options.search.split, runner, s, s.intervals, form_ranges, sweep == 0, [&](int done, int total) {
                  if (progress) progress({phase, done, total, "", SecondsSince(t0)});
                });
   }

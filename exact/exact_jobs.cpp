@@ -58,7 +58,8 @@ nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool c
 
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap,
-                                const std::vector<DynamicsForm>& forms, std::optional<int> lp_budget) {
+                                const std::vector<DynamicsForm>& forms, std::optional<int> lp_budget,
+                                const std::optional<ParamBox>& scale) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& b : boxes) list.push_back(BoxToJson(b));
   nlohmann::json j = {{"kind", kObjectiveKind}, {"start", BoxToJson(start)}, {"boxes", list},
@@ -66,6 +67,7 @@ nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBo
   j["target"] = target ? nlohmann::json(*target) : nlohmann::json(nullptr);
   if (!forms.empty()) j["forms"] = FormsToJson(forms);
   if (lp_budget) j["lp_budget"] = *lp_budget;
+  if (scale) j["scale"] = BoxToJson(*scale);
   return j;
 }
 
@@ -107,9 +109,12 @@ sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSett
       with_forms = data;
       with_forms.dynamics_forms = FormsFromJson(spec.at("forms"));
     }
+    std::optional<ParamBox> scale;
+    if (spec.contains("scale")) scale = BoxFromJson(spec.at("scale"));
     const ObjectiveSearchResult r =
         SearchObjective(spec.contains("forms") ? with_forms : data, BoxFromJson(spec.at("start")), boxes, objective,
-                        target, spec.at("target_gap").get<double>(), search, settings.evaluation, *solver);
+                        target, spec.at("target_gap").get<double>(), search, settings.evaluation, *solver,
+                        scale ? &*scale : nullptr);
     return r.to_json().dump();
   };
 }

@@ -23,7 +23,8 @@ nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool c
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap,
                                 const std::vector<DynamicsForm>& forms = {},
-                                std::optional<int> lp_budget = std::nullopt);  // default: the settings' budget
+                                std::optional<int> lp_budget = std::nullopt,  // default: the settings' budget
+                                const std::optional<ParamBox>& scale = std::nullopt);  // see SearchObjective
 
 // Answers either kind of spec (called in the worker process).
 sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSettings& settings);

@@ -105,10 +105,12 @@ void LiftedLp::SetSlackObjective() {
   lp.obj[s_col] = 1.0;
 }
 
-void LiftedLp::SetRatioObjective(int j_index, int k, double g) {
+void LiftedLp::SetRatioObjective(const std::vector<std::pair<int, double>>& terms, int k, double g) {
   std::fill(lp.obj.begin(), lp.obj.end(), 0.0);
-  lp.obj[beta_col[j_index][k]] = 1.0;
-  lp.obj[beta_col[j_index][0]] = -g;
+  for (const auto& [j_index, w] : terms) {
+    lp.obj[beta_col[j_index][k]] += w;
+    lp.obj[beta_col[j_index][0]] -= w * g;
+  }
 }
 
 LiftedLp BuildLiftedLp(const LiftedData& d, const ParamBox& box, Window window, LiftedForm form) {

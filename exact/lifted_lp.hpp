@@ -65,8 +65,9 @@ struct LiftedLp {
   // Sets the objective to minimise sum_k weight_k * parameter_k (0 elsewhere); the feasibility form minimises s.
   void SetParameterObjective(const std::vector<double>& weights);
   void SetSlackObjective();
-  // Objective over the beta columns too: minimise beta_{j,k} - g * beta_{j,1} (Dinkelbach step for gamma_k).
-  void SetRatioObjective(int j_index, int k, double g);
+  // Objective over the beta columns too: minimise sum_j w_j (beta_{j,k} - g * beta_{j,1}) over the terms
+  // (j_index, w_j) (a Dinkelbach step for gamma_k).
+  void SetRatioObjective(const std::vector<std::pair<int, double>>& terms, int k, double g);
   std::vector<std::vector<int>> beta_col;  // [j - j0][k]: beta_jk; k = 0 is b_j itself
 };
 

@@ -181,8 +181,9 @@ int main(int argc, char** argv) {
   std::string lp_solver = exact::ExactBoundsOptions{}.lp_solver;
   std::string split = exact::ToString(exact::ObjectiveSearchOptions{}.split);
   int samples = 0;
-  bool rotate = exact::ObjectiveSearchOptions{}.rotate_denominators;
+  std::string gamma_ratio = exact::ToString(exact::ObjectiveSearchOptions{}.gamma_ratio);
   std::string run_dir;
+  std::vector<std::string> parameters;
   std::vector<std::string> summarise;
   std::string summary_out;
   app.add_option("--tables", tables, "a committed cerone_tables result (tables.json) with an n = 2 case");
@@ -201,13 +202,18 @@ int main(int argc, char** argv) {
     std::string error;
     return exact::ValidLpSolverName(name, &error) ? std::string() : error;
   });
-  app.add_option("--split", split, "what an endpoint's refinement halves: dynamics or alternate")
+  app.add_option("--split", split, "what an endpoint's refinement halves: dynamics, alternate or family")
       ->check([](const std::string& name) {
         exact::EndpointSplit parsed;
-        return exact::ParseEndpointSplit(name, &parsed) ? std::string() : "expected dynamics or alternate";
+        return exact::ParseEndpointSplit(name, &parsed) ? std::string() : "expected dynamics, alternate or family";
       });
   app.add_option("--run-dir", run_dir, "keep the jobs' answers here; a rerun (or a run with more sweeps) reads them");
-  app.add_option("--rotate-denominators", rotate, "gamma through each b_j of one sign in turn (true/false)");
+  app.add_option("--gamma-ratio", gamma_ratio, "how a gamma's bound divides by the b_j: largest, rotate or pooled")
+      ->check([](const std::string& text) {
+        exact::GammaRatio r;
+        return exact::ParseGammaRatio(text, &r) ? std::string() : "expected largest, rotate or pooled, not " + text;
+      });
+  app.add_option("--parameters", parameters, "intervals to compute (default: all), e.g. gamma2,gamma3")->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   try {
     if (!summarise.empty()) {
@@ -234,10 +240,11 @@ int main(int argc, char** argv) {
     options.threads = threads;
     options.search.lp_budget = lp_budget;
     exact::ParseEndpointSplit(split, &options.search.split);
-    options.search.rotate_denominators = rotate;
+    exact::ParseGammaRatio(gamma_ratio, &options.search.gamma_ratio);
     options.run_dir = run_dir;
     options.sweeps = sweeps;
     options.lp_solver = lp_solver;
+    options.parameters = parameters;
     const auto s = exact::ComputeExactBounds(options, dss::CeroneExampleStructure(), data, one.box,
                                              [](const exact::ExactBoundsProgress& p) {
                                                fmt::print(stderr, "[{:.0f} s] {} {}/{} {}\n", p.elapsed_seconds, p.phase,
@@ -248,11 +255,11 @@ int main(int argc, char** argv) {
         "# Exact set D, seed {}, N = {}, {} dB (realised {:.2f} dB), noise bound {:.6g}\n\n"
         "Start box: D^ss(2) at δ = {} from `{}` (stage 1: {:.0f} s wall in that committed run, which may have read "
         "its jobs from a run cache){}. Command: `exact_tables --tables {} --out {} --threads {} --lp-budget {} "
-        "--sweeps {} --lp-solver {} --split {} --rotate-denominators {}{}`.\n\n",
+        "--sweeps {} --lp-solver {} --split {} --gamma-ratio {}{}`.\n\n",
         one.seed, one.samples, one.snr_db, ex.snr_db, ex.noise_bound, one.order, tables, one.seconds,
         box_proven ? "" : fmt::format("; that run's record is not this one, so here the box is an assumed prior box "
                                       "(the intervals bound D inside it), not a proven one"),
-        tables, out, threads, lp_budget, sweeps, lp_solver, split, rotate, box_proven ? "" : fmt::format(" --samples {}", samples));
+        tables, out, threads, lp_budget, sweeps, lp_solver, split, gamma_ratio, box_proven ? "" : fmt::format(" --samples {}", samples));
     md += Table(s, one, truth);
     md += fmt::format("\nStage 2: {:.1f} s wall on {} (prune {:.1f} s, inner hull {:.1f} s, bound {:.1f} s); {} "
                       "levels, {} boxes tested, {} pruned; {} LPs of {} x {} ({} nonzeros), {} not optimal. "

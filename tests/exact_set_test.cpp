@@ -195,7 +195,8 @@ std::vector<std::vector<double>> IndependentMembers(const LiftedData& d, const t
 
 // Soundness over many seeded random systems of several structures: the truth and every independently found
 // point of D lie in every interval.
-void CheckSoundness(uint64_t first_seed, int count, const std::string& lp_solver = "clp") {
+void CheckSoundness(uint64_t first_seed, int count, const std::string& lp_solver = "clp",
+                    EndpointSplit split = EndpointSplit::kDynamics, GammaRatio gamma_ratio = GammaRatio::kLargest) {
   int members_checked = 0;
   std::mt19937 rng(static_cast<unsigned>(first_seed));
   ClpSolver clp;
@@ -207,6 +208,8 @@ void CheckSoundness(uint64_t first_seed, int count, const std::string& lp_solver
     const ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
     ExactBoundsOptions options = SmallRunOptions();
     options.lp_solver = lp_solver;
+    options.search.split = split;
+    options.search.gamma_ratio = gamma_ratio;
     const ExactBoundsSummary s = ComputeExactBounds(options, inst.structure, inst.data, start);
     ASSERT_FALSE(s.invalidated) << inst.description;
     for (const auto& p : IndependentMembers(d, inst, start, clp, rng)) {
@@ -227,6 +230,14 @@ TEST(ExactSoundness, RandomSystemsSeeds76To100) { CheckSoundness(76, 25); }
 // The interior-point backend on other systems (its duals, not a simplex's, certify every prune and bound).
 TEST(ExactSoundness, RandomSystemsSeeds101To125InteriorPoint) { CheckSoundness(101, 25, "ipm"); }
 TEST(ExactSoundness, RandomSystemsSeeds126To150InteriorPoint) { CheckSoundness(126, 25, "ipm"); }
+// The other splits (boxes cut across the endpoint's own family of parameters) and gamma ratios (each b_j in turn,
+// all b_j pooled: other certificates).
+TEST(ExactSoundness, RandomSystemsSeeds151To175FamilySplitPooledRatio) {
+  CheckSoundness(151, 25, "clp", EndpointSplit::kFamily, GammaRatio::kPooled);
+}
+TEST(ExactSoundness, RandomSystemsSeeds176To200AlternateSplitRotatedRatio) {
+  CheckSoundness(176, 25, "clp", EndpointSplit::kAlternate, GammaRatio::kRotate);
+}
 
 TEST(ExactBounds, NarrowerThanTheStartBoxAndTheSameOnEveryExecutor) {
   const auto inst = InstanceOf(5, 80);

@@ -1,0 +1,88 @@
+// Which range does an endpoint's relaxation bound depend on? On a committed exact-set result (the box it proved,
+// its forms), the bound of one endpoint on that box, then on the same box with one entry at a time narrowed to
+// a share of its width around the inner hull's point extreme in that endpoint: the entry whose narrowing moves
+// the bound most is the one a branch and bound should split for it.
+//   exact_endpoint_probe --result paper_examples/results/exact_snr31_seed1/exact.json --parameter gamma2 --max
+#include <fstream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/cerone_example.hpp"
+#include "dss/hw_outer_set.hpp"
+#include "exact/box_evaluation.hpp"
+#include "exact/dynamics_forms.hpp"
+#include "exact/inner_hull.hpp"
+#include "exact/lifted_lp.hpp"
+#include "exact/lp_solver.hpp"
+
+namespace ex = hw::exact;
+
+int main(int argc, char** argv) {
+  CLI::App app{"Sensitivity of an exact-set endpoint's LP bound to each range of the box"};
+  std::string result_path, parameter = "gamma2", solver_name = "ipm", ratio_name = "largest";
+  bool maximise = false;
+  double share = 0.1;
+  app.add_option("--result", result_path, "exact.json of a committed exact_tables run (seed and N from it)")->required();
+  app.add_option("--parameter", parameter, "the endpoint's parameter");
+  app.add_flag("--max", maximise, "the upper endpoint (default: the lower)");
+  app.add_option("--share", share, "each narrowed range keeps this share of its width")->check(CLI::Range(1e-6, 1.0));
+  app.add_option("--lp-solver", solver_name);
+  app.add_option("--gamma-ratio", ratio_name);
+  CLI11_PARSE(app, argc, argv);
+  std::ifstream in(result_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& real = j.at("realisation");
+  const auto ex_data = hw::SimulateCeroneExample(real.at("seed").get<uint64_t>(), real.at("samples").get<int>(),
+                                                 real.at("snr_db").get<double>());
+  hw::dss::HwData data{ex_data.u, ex_data.y, std::vector<double>(ex_data.y.size(), ex_data.noise_bound), "probe"};
+  auto lifted = ex::MakeLiftedData(hw::dss::CeroneExampleStructure(), data);
+  lifted.dynamics_forms = ex::FormsFromJson(j.at("stage2").at("dynamics_forms"));
+  ex::ParamBox box;
+  for (const auto& iv : j.at("intervals")) box.emplace_back(iv.at("lower").at("value"), iv.at("upper").at("value"));
+  const auto& names = lifted.layout.names;
+  const int p = static_cast<int>(std::find(names.begin(), names.end(), parameter) - names.begin());
+  if (p >= lifted.layout.count()) throw std::invalid_argument("unknown parameter " + parameter);
+  auto solver = ex::MakeLpSolver(solver_name);
+  ex::GammaRatio ratio;
+  ex::ParseGammaRatio(ratio_name, &ratio);
+
+  // The point of D extreme in the endpoint (inner hull from the truth).
+  const auto hull = ex::ComputeInnerHull(lifted, box, hw::CeroneExample::TrueParameters(), ex::InnerHullOptions{}, *solver);
+  std::vector<double> extreme;
+  for (const auto& pt : hull.points)
+    if (extreme.empty() || (maximise ? pt.theta[p] > extreme[p] : pt.theta[p] < extreme[p])) extreme = pt.theta;
+  fmt::print("inner extreme of {}: {:.7f}\n", parameter, extreme[p]);
+  box = ex::WithFormRanges(lifted, box);
+  ex::PropagateForms(lifted, box);
+  const ex::Objective objective{p, maximise};
+  ex::BoxEvaluationOptions options;
+  auto bound_on = [&](const ex::ParamBox& b) {
+    const auto e = ex::BoundObjective(lifted, b, objective, options, *solver, {}, ratio);
+    return std::pair{e.bound ? *e.bound : NAN, e.lps};
+  };
+  const auto [b0, lps0] = bound_on(box);
+  fmt::print("whole box: bound {:.7f} (gap to inner {:.3g}, {} LPs)\n", b0, std::abs(b0 - extreme[p]), lps0);
+  std::vector<double> at = extreme;
+  for (const auto& f : lifted.dynamics_forms) at.push_back(ex::FormValue(lifted, f, extreme));
+  auto narrowed = [&](ex::ParamBox b, int k) {
+    const double half = 0.5 * share * (b[k].hi - b[k].lo);
+    const double c = std::clamp(at[k], b[k].lo + half, b[k].hi - half);
+    b[k] = ex::Interval(c - half, c + half);
+    ex::PropagateForms(lifted, b);
+    return b;
+  };
+  for (std::size_t k = 0; k < box.size(); ++k) {
+    const std::string name = static_cast<int>(k) < lifted.layout.count() ? names[k] : fmt::format("form{}", k - names.size());
+    const auto [bk, lps] = bound_on(narrowed(box, static_cast<int>(k)));
+    fmt::print("{:>7} narrowed to {:.2g} of its width: bound {:.7f}, gap to inner {:.3g} ({:.0f} % of the gap closed, {} LPs)\n",
+               name, share, bk, std::abs(bk - extreme[p]), 100 * (1 - std::abs(bk - extreme[p]) / std::abs(b0 - extreme[p])), lps);
+  }
+  ex::ParamBox all = box;
+  for (std::size_t k = 0; k < box.size(); ++k)
+    if (static_cast<int>(k) != p) all = narrowed(all, static_cast<int>(k));
+  const auto [ba, lpsa] = bound_on(all);
+  fmt::print("every other entry narrowed: bound {:.7f}, gap to inner {:.3g}\n", ba, std::abs(ba - extreme[p]));
+  return 0;
+}
