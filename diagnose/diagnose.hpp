@@ -54,8 +54,10 @@ enum class NominalStatus {
 std::string NominalStatusName(NominalStatus s);  // "reached_noise_floor", "explained_by_effect", "failed"
 
 // Recordings made around an operating point far from 0 are diagnosed in deviations u - u_op, y - y_op
-// (u_op, y_op = the identification recording's medians), so that effects acting around the operating
-// point (a dead band, a relay) are found there and polynomial maps stay well conditioned.
+// (u_op, y_op = the identification recording's means, as in the usual detrending: the median of a
+// two-level or step input is one of its levels, which would put the 0 of a relay or a state effect at
+// the edge of the signal), so that effects acting around the operating point (a dead band, a relay) are
+// found there and polynomial maps stay well conditioned.
 struct OperatingPoint {
   bool u_removed = false, y_removed = false;
   double u = 0.0, y = 0.0;

@@ -305,7 +305,15 @@ EffectBlock EffectBlock::from_json(const nlohmann::json& e) {
   return b;
 }
 
-double ApplyStaticBlock(const EffectBlock& block, double v) {
+// Rounding smoothed over a width w (in steps): the staircase k + sum of logistic steps at the nearest
+// half-integers, which tends to round(x) as w -> 0.
+double SmoothRound(double x, double w) {
+  const double k = std::floor(x), f = x - k;
+  auto step = [w](double d) { return 1.0 / (1.0 + std::exp(-d / w)); };
+  return k + step(f - 0.5) + step(f - 1.5) - step(-f - 0.5);
+}
+
+double ApplyStaticBlock(const EffectBlock& block, double v, double smoothing) {
   switch (block.effect) {
     case Effect::kDeadzone: {
       // A dead band of half-width d around c (0 unless the band sits at an operating point).
@@ -317,7 +325,8 @@ double ApplyStaticBlock(const EffectBlock& block, double v) {
     case Effect::kQuantization: {
       // Levels offset + k step: the grid of a quantizer need not pass through the recording's 0.
       const double o = block.params.size() > 1 ? block.params[1] : 0.0;
-      return o + block.params[0] * std::round((v - o) / block.params[0]);
+      const double x = (v - o) / block.params[0];
+      return o + block.params[0] * (smoothing > 0 ? SmoothRound(x, smoothing) : std::round(x));
     }
     default:
       return v;
@@ -474,7 +483,7 @@ bool AugmentedModel::simulate(const std::vector<double>& u, std::vector<double>*
   for (auto& v : *y) {
     v = nominal.output(v) + output_offset;
     for (const auto& b : blocks)
-      if (b.location == Location::kOutput) v = ApplyStaticBlock(b, v);
+      if (b.location == Location::kOutput) v = ApplyStaticBlock(b, v, output_quantizer_smoothing);
   }
   return ok;
 }

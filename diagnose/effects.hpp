@@ -96,6 +96,9 @@ struct AugmentedModel {
   // z_{-1}, ..., z_{-na} (the linear block's state before the first sample; past inputs are 0). Empty =
   // from rest.
   std::vector<double> initial_state;
+  // Width (in steps) of a smooth rounding used for output quantizers while an optimiser moves the other
+  // numbers (0: the exact staircase). Never written or read: a fitting aid only (see refit.cpp).
+  double output_quantizer_smoothing = 0.0;
 
   bool has_block() const { return !blocks.empty(); }
   Effect effect() const { return blocks.empty() ? Effect::kNone : blocks.front().effect; }
@@ -123,6 +126,7 @@ std::vector<double> FrictionLevelsInInputUnits(const EffectBlock& block, const A
 
 // Applies a memoryful or static input-location block to a signal (exposed for tests and the generator).
 std::vector<double> ApplyInputBlock(const EffectBlock& block, const std::vector<double>& u);
-double ApplyStaticBlock(const EffectBlock& block, double v);  // deadzone, saturation, quantization
+// Deadzone, saturation, quantization; `smoothing` > 0 rounds a quantizer smoothly (width in steps).
+double ApplyStaticBlock(const EffectBlock& block, double v, double smoothing = 0.0);
 
 }  // namespace hw::diagnose

@@ -319,6 +319,40 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
   return g;
 }
 
+// A quantized output shows its levels: the measured y sits at o + k q plus noise. The circular mean
+// R(q) = |mean exp(2 pi i y / q)| is near exp(-2 pi^2 sigma^2 / q^2) at the true step (and small for a
+// step the levels do not repeat), its angle gives the grid offset o. The steps of the few largest local
+// maxima of R over the quantizer grid's steps that stand clear of what noise alone gives (3 / sqrt(n)),
+// with their offsets: starts taken from the data themselves, not from a nominal's prediction.
+std::vector<Vec> OutputLevelStarts(const Vec& y, std::size_t from, std::size_t to, double range) {
+  const std::size_t n = to > from ? to - from : 0;
+  if (n < 20) return {};
+  const Vec steps = LogSpace(3e-3 * range, 0.3 * range, 460);
+  Vec r(steps.size()), phase(steps.size());
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    double c = 0.0, sn = 0.0;
+    for (std::size_t t = from; t < to; ++t) {
+      const double a = 2.0 * M_PI * y[t] / steps[k];
+      c += std::cos(a), sn += std::sin(a);
+    }
+    r[k] = std::hypot(c, sn) / n;
+    phase[k] = std::atan2(sn, c);
+  }
+  std::vector<std::pair<double, std::size_t>> peaks;
+  for (std::size_t k = 1; k + 1 < steps.size(); ++k)
+    if (r[k] >= r[k - 1] && r[k] >= r[k + 1] && r[k] > 3.0 / std::sqrt(static_cast<double>(n))) peaks.emplace_back(r[k], k);
+  std::sort(peaks.rbegin(), peaks.rend());
+  std::vector<Vec> out;
+  for (std::size_t i = 0; i < peaks.size() && i < 3; ++i) {
+    const std::size_t k = peaks[i].second;
+    const double q = steps[k];
+    double o = q * phase[k] / (2.0 * M_PI);
+    if (o < 0) o += q;
+    out.push_back({q, o});
+  }
+  return out;
+}
+
 // Finer search around a value for parameters that only a search can move.
 Vec LocalValues(const EffectBlock& b, int index) {
   const Effect e = b.effect;
@@ -355,22 +389,20 @@ Vec LocalValues(const EffectBlock& b, int index) {
   return out;
 }
 
-// Scans parameter i of block b over `values` (numerator, offset and initial state re-solved at each) and
-// moves it to the middle of the run of values whose cost ties with the best. A threshold between two
-// levels of a step or PRBS input changes nothing on the data anywhere between them, and the middle of
-// that interval is the choice that does not sit at the edge of what the data show. The model only
-// changes when the chosen value costs no more than the current model. Stiction's bands are the
-// exception: within a tie they take the end nearest to backlash (the smallest static band, the largest
-// kinetic band), so that a stick-slip jump the data do not show is not invented. Returns whether the run
-// reached an end of `values` (the tie may extend beyond them).
-bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& values, const Segment& s,
-                  const RefitOptions& o) {
+// Scans one number of the model over `values` (`set` writes a value into a copy and says whether it is
+// admissible; numerator, offset and initial state re-solved at each) and moves it to the middle of the
+// run of values whose cost ties with the best (or to the run's lowest or highest value, `pick_rule`). A
+// threshold between two levels of a step or PRBS input changes nothing on the data anywhere between
+// them, and the middle of that interval is the choice that does not sit at the edge of what the data
+// show. The model only changes when the chosen value costs no more than the current model. Returns
+// whether the run reached an end of `values` (the tie may extend beyond them).
+enum class TiePick { kMiddle, kLowest, kHighest };
+bool CentreInTies(AugmentedModel* m, const std::function<bool(AugmentedModel*, double)>& set, const Vec& values,
+                  const Segment& s, const RefitOptions& o, TiePick pick_rule) {
   std::vector<std::pair<double, std::pair<double, AugmentedModel>>> tried;  // value -> (cost, model)
   for (double v : values) {
     AugmentedModel t = *m;
-    t.blocks[b].params[i] = v;
-    std::string err;
-    if (!t.blocks[b].IsValid(&err)) continue;
+    if (!set(&t, v)) continue;
     SolveNumerator(&t, s, o);
     const double c = SumSquaredError(t, s);
     if (std::isfinite(c)) tried.push_back({v, {c, std::move(t)}});
@@ -386,10 +418,61 @@ bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& va
   while (hi + 1 < tried.size() && tried[hi + 1].second.first <= cmin + tol) ++hi;
   const double current = SumSquaredError(*m, s);
   if (cmin > current + 1e-9 * current) return false;
-  const bool stiction = m->blocks[b].effect == Effect::kStiction;
-  const std::size_t pick = stiction ? (i == 0 ? lo : hi) : (lo + hi) / 2;
+  const std::size_t pick = pick_rule == TiePick::kLowest ? lo : (pick_rule == TiePick::kHighest ? hi : (lo + hi) / 2);
   *m = tried[pick].second.second;
-  return stiction ? (pick == 0 || pick + 1 == tried.size()) && lo != hi : lo == 0 || hi + 1 == tried.size();
+  if (pick_rule != TiePick::kMiddle) return (pick == 0 || pick + 1 == tried.size()) && lo != hi;
+  return lo == 0 || hi + 1 == tried.size();
+}
+
+// Parameter i of block b. Stiction's bands are the exception to the middle: within a tie they take the
+// end nearest to backlash (the smallest static band, the largest kinetic band), so that a stick-slip
+// jump the data do not show is not invented.
+bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& values, const Segment& s,
+                  const RefitOptions& o) {
+  const bool stiction = m->blocks[b].effect == Effect::kStiction;
+  const TiePick rule = stiction ? (i == 0 ? TiePick::kLowest : TiePick::kHighest) : TiePick::kMiddle;
+  const auto set = [b, i](AugmentedModel* t, double v) {
+    t->blocks[b].params[i] = v;
+    std::string err;
+    return t->blocks[b].IsValid(&err);
+  };
+  return CentreInTies(m, set, values, s, o, rule);
+}
+
+// Under an output quantizer the output offset (added before the quantizer) moves the simulated output
+// by whole steps at a time: its cost is a staircase that LM cannot descend, and an offset carried over
+// from the nominal fit (which averaged the steps) can sit a fraction of a step from the truth. It is
+// searched over one step around its value (quantizer held), the middle of a tie kept. Returns whether
+// the model has such a quantizer (and the offset was searched).
+bool SearchOffsetUnderOutputQuantizer(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  double q = 0.0;
+  for (const auto& b : m->blocks)
+    if (b.effect == Effect::kQuantization && b.location == Location::kOutput) q = b.params[0];
+  if (!(q > 0) || !o.fit_output_offset) return false;
+  const auto set_offset = [](AugmentedModel* t, double v) {
+    t->output_offset = v;
+    return true;
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    Vec offsets;
+    for (int k = -20; k <= 20; ++k) offsets.push_back(m->output_offset + q * k / 40.0);
+    if (!CentreInTies(m, set_offset, offsets, s, o, TiePick::kMiddle)) break;
+  }
+  return true;
+}
+
+// The other numbers under an output quantizer (linear block, maps, offset, initial state) see a cost
+// that is piecewise constant, so LM from the nominal's values barely moves them, and a quantizer with the
+// right step then mispredicts new data. They are refitted by continuation: LM with the rounding smoothed
+// over a quarter and then a tenth of a step, then the exact staircase; kept when the exact cost drops.
+void RefitUnderSmoothedOutputQuantizer(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  AugmentedModel t = *m;
+  for (double width : {0.25, 0.1}) {
+    t.output_quantizer_smoothing = width;
+    Lm(&t, Packing::For(t, o), s, o.lm);
+  }
+  t.output_quantizer_smoothing = 0.0;
+  if (SumSquaredError(t, s) < SumSquaredError(*m, s)) *m = t;
 }
 
 // Whether the cost is flat around parameter i of block b (1 % either side): a smooth parameter between
@@ -408,16 +491,27 @@ bool FlatAround(const AugmentedModel& m, std::size_t b, std::size_t i, const Seg
 
 // Local search of every search-only parameter (and of smooth ones on a flat cost), centred in the run
 // of tied values and repeated while that run reaches the end of the local values; then LM again.
-void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
-  bool any = false;
+void SearchBlockParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o, bool* any) {
   for (std::size_t b = 0; b < m->blocks.size(); ++b)
     for (std::size_t i = 0; i < m->blocks[b].params.size(); ++i) {
       const bool smooth = ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i));
       if (smooth && !FlatAround(*m, b, i, s)) continue;
-      any = true;
+      *any = true;
       for (int pass = 0; pass < 3; ++pass)
         if (!CentreInTies(m, b, i, LocalValues(m->blocks[b], static_cast<int>(i)), s, o)) break;
     }
+}
+
+// Under an output quantizer, the offset search and the smoothed refit move the numbers the quantizer's
+// step and grid offset were searched with: those are searched once more.
+void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  bool any = false;
+  SearchBlockParameters(m, s, o, &any);
+  if (SearchOffsetUnderOutputQuantizer(m, s, o)) {
+    RefitUnderSmoothedOutputQuantizer(m, s, o);
+    SearchBlockParameters(m, s, o, &any);
+    any = true;
+  }
   if (any) Lm(m, Packing::For(*m, o), s, o.lm);
 }
 
@@ -670,6 +764,17 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     }
   }
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  // An output quantizer's levels read from the measured output are refined in any case (their score
+  // with the nominal's numbers can be poor when its offset sits a fraction of a step off).
+  if (effect == Effect::kQuantization && location == Location::kOutput) {
+    const double range = std::max(Quantile(yhat, 1.0) - Quantile(yhat, 0.0), 1e-12);
+    for (const Vec& p : OutputLevelStarts(*s.y, s.skip, s.End(), range)) {
+      AugmentedModel m = base;
+      m.blocks.push_back({effect, location, p, sv});
+      if (o.estimate_initial_state) m.initial_state.resize(m.nominal.linear.a.size(), 0.0);
+      scored.insert(scored.begin(), {SumSquaredError(m, s), m});
+    }
+  }
   RefitResult best;
   best.sse = std::numeric_limits<double>::infinity();
   // A quantizer's cost is jagged in its step (every step size shifts which levels the data land on): its

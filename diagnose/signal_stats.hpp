@@ -23,6 +23,12 @@ inline double Median(std::vector<double> v) {
   return v[m];
 }
 
+inline double Mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / v.size();
+}
+
 inline double Rms(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += x * x;
@@ -31,9 +37,8 @@ inline double Rms(const std::vector<double>& v) {
 
 inline double StdDev(const std::vector<double>& v) {
   if (v.empty()) return 0.0;
-  double m = 0.0, s = 0.0;
-  for (double x : v) m += x;
-  m /= v.size();
+  const double m = Mean(v);
+  double s = 0.0;
   for (double x : v) s += (x - m) * (x - m);
   return std::sqrt(s / v.size());
 }

@@ -239,6 +239,31 @@ TEST(Refit, AThresholdBetweenTwoInputLevelsIsPlacedInsideTheInterval) {
   EXPECT_NEAR(r.model.blocks[0].params[1], 0.3, 0.03);
 }
 
+// Under an output quantizer the output offset moves the prediction by whole steps: started a third of a
+// step away from the truth (as a nominal fitted without the quantizer leaves it), LM alone cannot
+// descend the staircase; the offset search puts it back within a tenth of a step.
+TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Vec u(800);
+  double lp = 0.0;
+  for (auto& v : u) v = lp = 0.9 * lp + 0.3 * g(rng);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.7}, {0.5}, 0};
+  truth.blocks.push_back({Effect::kQuantization, Location::kOutput, {0.25, 0.0}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  for (auto& v : y) v += 0.02 * g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  AugmentedModel start = truth;
+  start.output_offset = 0.25 / 3;
+  RefitOptions o;
+  o.estimate_initial_state = false;
+  const RefitResult r = RefitModel(start, seg, o);
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_NEAR(r.model.output_offset, 0.0, 0.025);
+  EXPECT_LT(r.sse, SumSquaredError(start, seg));
+}
+
 // Data from a mass–spring–damper whose "friction" pushes along the motion (a negative Coulomb level):
 // an unconstrained fit returns a negative coefficient; the diagnosis must never report one.
 TEST(Refit, FrictionIsNeverReportedWithANegativeLevel) {
