@@ -7,9 +7,11 @@
 
 #include <fmt/format.h>
 
+#include "exact/enum_names.hpp"
 #include "exact/safe_bound.hpp"
 
 namespace hw::exact {
+
 std::string ToString(GammaRatio ratio) {
   switch (ratio) {
     case GammaRatio::kLargest: return "largest";
@@ -20,12 +22,7 @@ std::string ToString(GammaRatio ratio) {
 }
 
 bool ParseGammaRatio(const std::string& text, GammaRatio* ratio) {
-  for (GammaRatio r : {GammaRatio::kLargest, GammaRatio::kRotate, GammaRatio::kPooled})
-    if (text == ToString(r)) {
-      *ratio = r;
-      return true;
-    }
-  return false;
+  return ParseByName(text, {GammaRatio::kLargest, GammaRatio::kRotate, GammaRatio::kPooled}, ratio);
 }
 
 namespace {

@@ -5,36 +5,44 @@
 #include <cmath>
 #include <tuple>
 
-namespace hw::exact {
+#include "exact/enum_names.hpp"
 
-int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& start) {
-  const auto& lay = data.layout;
-  int best = lay.a_begin;
-  double best_ratio = -1.0;
-  auto consider = [&](int k) {
-    const double ratio = (box[k].hi - box[k].lo) / (start[k].hi - start[k].lo);
-    if (ratio > best_ratio) best_ratio = ratio, best = k;
-  };
-  // Forms first: on a tie the cut across D's strip removes more.
-  if (box.size() == start.size())
-    for (std::size_t k = lay.count(); k < box.size(); ++k) consider(static_cast<int>(k));
-  for (int i = 0; i < data.structure.na; ++i) consider(lay.a_begin + i);
-  return best;
-}
+namespace hw::exact {
 
 namespace {
 
-// The entries an endpoint of parameter p halves with EndpointSplit::kFamily: the a_i, the forms, and p's family.
+// The entry of `entries` (the first of equals) whose width in `box` is the largest against its width in
+// `reference`; a point-like reference width counts as a millionth of the start's.
+int WidestAgainst(const std::vector<int>& entries, const ParamBox& box, const ParamBox& reference,
+                  const ParamBox& start) {
+  int best = entries.front();
+  double best_ratio = -1.0;
+  for (int k : entries) {
+    const double extent = std::max(reference[k].hi - reference[k].lo, 1e-6 * (start[k].hi - start[k].lo));
+    const double ratio = (box[k].hi - box[k].lo) / extent;
+    if (ratio > best_ratio) best_ratio = ratio, best = k;
+  }
+  return best;
+}
+
+// The dynamics' entries: the forms first (on a tie the cut across D's strip removes more), then the a_i.
+std::vector<int> DynamicsEntries(const LiftedData& data, std::size_t box_size) {
+  const auto& lay = data.layout;
+  std::vector<int> entries;
+  for (int k = lay.count(); k < static_cast<int>(box_size); ++k) entries.push_back(k);
+  for (int i = 0; i < data.structure.na; ++i) entries.push_back(lay.a_begin + i);
+  return entries;
+}
+
+// The entries an endpoint of parameter p halves with EndpointSplit::kFamily: the dynamics' and p's family.
 std::vector<int> FamilyEntries(const LiftedData& data, int p, std::size_t box_size) {
   const auto& lay = data.layout;
   auto in = [](int k, int begin, int count) { return k >= begin && k < begin + count; };
   const int nb = lay.count() - lay.b_begin;
-  std::vector<int> entries;
+  std::vector<int> entries = DynamicsEntries(data, box_size);
   auto add = [&](int begin, int count) {
     for (int k = begin; k < begin + count; ++k) entries.push_back(k);
   };
-  add(lay.count(), static_cast<int>(box_size) - lay.count());  // forms first: on a tie the cut across D's strip
-  add(lay.a_begin, data.structure.na);
   if (in(p, lay.gamma_begin, lay.num_gamma)) add(lay.gamma_begin, lay.num_gamma);
   if (in(p, lay.alpha_begin, lay.num_alpha) || in(p, lay.b_begin, nb)) {
     add(lay.alpha_begin, lay.num_alpha);
@@ -45,19 +53,15 @@ std::vector<int> FamilyEntries(const LiftedData& data, int p, std::size_t box_si
 
 }  // namespace
 
+int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& start) {
+  return WidestAgainst(DynamicsEntries(data, box.size() == start.size() ? box.size() : 0), box, start, start);
+}
+
 int SplitEntry(const LiftedData& data, const ParamBox& box, const ParamBox& start, int p, EndpointSplit split,
                const ParamBox* scale) {
   if (split != EndpointSplit::kFamily) return SplitParameter(data, box, start);
   const ParamBox& reference = scale && scale->size() == box.size() ? *scale : start;
-  int best = -1;
-  double best_ratio = -1.0;
-  for (int k : FamilyEntries(data, p, std::min(box.size(), start.size()))) {
-    // A point-like extent (one inner point) counts as a millionth of the start's width.
-    const double extent = std::max(reference[k].hi - reference[k].lo, 1e-6 * (start[k].hi - start[k].lo));
-    const double ratio = (box[k].hi - box[k].lo) / extent;
-    if (ratio > best_ratio) best_ratio = ratio, best = k;
-  }
-  return best;
+  return WidestAgainst(FamilyEntries(data, p, std::min(box.size(), start.size())), box, reference, start);
 }
 
 std::pair<ParamBox, ParamBox> CutBox(const ParamBox& box, int parameter, double cut) {
@@ -108,12 +112,7 @@ std::string ToString(EndpointSplit split) {
 }
 
 bool ParseEndpointSplit(const std::string& text, EndpointSplit* split) {
-  for (EndpointSplit s : {EndpointSplit::kDynamics, EndpointSplit::kAlternate, EndpointSplit::kFamily})
-    if (text == ToString(s)) {
-      *split = s;
-      return true;
-    }
-  return false;
+  return ParseByName(text, {EndpointSplit::kDynamics, EndpointSplit::kAlternate, EndpointSplit::kFamily}, split);
 }
 
 bool ObjectiveSearchOptions::IsValid(std::string* error) const {
