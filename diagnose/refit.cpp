@@ -777,9 +777,12 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   }
   RefitResult best;
   best.sse = std::numeric_limits<double>::infinity();
-  // A quantizer's cost is jagged in its step (every step size shifts which levels the data land on): its
-  // grid points scored with the baseline's numerator are a poor guide, and more of them are refined.
-  const int refine = effect == Effect::kQuantization ? 4 * o.keep_grid_points : o.keep_grid_points;
+  // A quantizer's cost is jagged in its step (every step size shifts which levels the data land on), a
+  // relay's in its threshold (every threshold changes which input moves switch it), a dead band's in its
+  // width and centre on an input of few levels (each level inside or outside the band): their grid
+  // points scored with the baseline's numerator are a poor guide, and more of them are refined.
+  const bool jagged = effect == Effect::kQuantization || effect == Effect::kHysteresis || effect == Effect::kDeadzone;
+  const int refine = jagged ? 4 * o.keep_grid_points : o.keep_grid_points;
   const int keep = std::min<int>(refine, static_cast<int>(scored.size()));
   for (int i = 0; i < keep; ++i) {
     AugmentedModel m = scored[i].second;
