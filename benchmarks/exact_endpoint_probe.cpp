@@ -32,6 +32,13 @@ int main(int argc, char** argv) {
   app.add_option("--lp-solver", solver_name);
   app.add_option("--gamma-ratio", ratio_name);
   bool bound_only = false, start_box = false;
+  double slab = 0.0;
+  int rounds = 2;
+  app.add_option("--slab", slab,
+                 "instead of narrowing: the slab of the endpoint's own range beyond the inner extreme plus this "
+                 "share of the gap; every other parameter bounded in it by LPs, then the endpoint, for --rounds")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--rounds", rounds, "with --slab: rounds of bounding every other parameter in the slab");
   app.add_flag("--start-box", start_box, "the run's start box (the D^ss box) instead of the box it proved");
   app.add_flag("--bound-only", bound_only, "the whole box's bound only (no narrowing)");
   CLI11_PARSE(app, argc, argv);
@@ -74,6 +81,40 @@ int main(int argc, char** argv) {
   fmt::print("whole box: bound {:.7f} (gap to inner {:.3g}, {} LPs, {:.2f} s)\n", b0, std::abs(b0 - extreme[p]), lps0,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (bound_only) return 0;
+  if (slab > 0.0) {
+    // The slab beyond extreme + slab * gap: is it empty, or how far does it reach, once every other range is
+    // bounded inside it?
+    ex::ParamBox b = box;
+    const double cut = extreme[p] + slab * (b0 - extreme[p]);
+    if (maximise) b[p] = ex::Interval(cut, b0);
+    else b[p] = ex::Interval(b0, cut);
+    int lps = 0;
+    for (int round = 1; round <= rounds; ++round) {
+      for (int k = 0; k < lifted.layout.count(); ++k) {
+        if (k == p) continue;
+        const double before = b[k].hi - b[k].lo;
+        for (bool up : {false, true}) {
+          const auto e = ex::BoundObjective(lifted, b, ex::Objective{k, up}, options, *solver, {}, ratio);
+          lps += e.lps;
+          if (e.verdict == ex::BoxVerdict::kPruned) {
+            fmt::print("round {}: the slab beyond {:.7f} is empty (pruned while bounding {}), {} LPs\n", round, cut,
+                       names[k], lps);
+            return 0;
+          }
+          if (!e.bound) continue;
+          if (up) b[k].hi = std::max(b[k].lo, std::min(b[k].hi, *e.bound));
+          else b[k].lo = std::min(b[k].hi, std::max(b[k].lo, *e.bound));
+        }
+        ex::PropagateForms(lifted, b);
+        fmt::print("round {}: {} keeps {:.2f} of its width in the slab\n", round, names[k], (b[k].hi - b[k].lo) / before);
+      }
+      const auto [bs, l] = bound_on(b);
+      lps += l;
+      fmt::print("round {}: slab beyond {:.7f}: bound {:.7f} ({:.0f} % of the gap closed), {} LPs so far\n", round, cut,
+                 bs, 100 * (1 - std::abs(bs - extreme[p]) / std::abs(b0 - extreme[p])), lps);
+    }
+    return 0;
+  }
   std::vector<double> at = extreme;
   for (const auto& f : lifted.dynamics_forms) at.push_back(ex::FormValue(lifted, f, extreme));
   auto narrowed = [&](ex::ParamBox b, int k) {
