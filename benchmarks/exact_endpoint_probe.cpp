@@ -20,6 +20,53 @@
 
 namespace ex = hw::exact;
 
+namespace {
+
+struct ProbeContext {
+  const ex::LiftedData& lifted;
+  const ex::BoxEvaluationOptions& options;
+  ex::LpSolver& solver;
+  ex::GammaRatio ratio;
+};
+
+// The slab of the endpoint's own range beyond extreme + share * (bound - extreme): is it empty, or how far does it
+// reach, once every other parameter's range is bounded inside it by LPs (`rounds` times)?
+void ProbeSlab(const ProbeContext& c, ex::ParamBox box, const ex::Objective& objective, double extreme, double bound,
+               double share, int rounds) {
+  const auto& names = c.lifted.layout.names;
+  const int p = objective.parameter;
+  const double cut = extreme + share * (bound - extreme);
+  box[p] = objective.maximise ? ex::Interval(cut, bound) : ex::Interval(bound, cut);
+  int lps = 0;
+  for (int round = 1; round <= rounds; ++round) {
+    for (int k = 0; k < c.lifted.layout.count(); ++k) {
+      if (k == p) continue;
+      const double before = box[k].hi - box[k].lo;
+      for (bool up : {false, true}) {
+        const auto e = ex::BoundObjective(c.lifted, box, ex::Objective{k, up}, c.options, c.solver, {}, c.ratio);
+        lps += e.lps;
+        if (e.verdict == ex::BoxVerdict::kPruned) {
+          fmt::print("round {}: the slab beyond {:.7f} is empty (pruned while bounding {}), {} LPs\n", round, cut,
+                     names[k], lps);
+          return;
+        }
+        if (!e.bound) continue;
+        if (up) box[k].hi = std::max(box[k].lo, std::min(box[k].hi, *e.bound));
+        else box[k].lo = std::min(box[k].hi, std::max(box[k].lo, *e.bound));
+      }
+      ex::PropagateForms(c.lifted, box);
+      fmt::print("round {}: {} keeps {:.2f} of its width in the slab\n", round, names[k], (box[k].hi - box[k].lo) / before);
+    }
+    const auto e = ex::BoundObjective(c.lifted, box, objective, c.options, c.solver, {}, c.ratio);
+    lps += e.lps;
+    const double b = e.bound ? *e.bound : NAN;
+    fmt::print("round {}: slab beyond {:.7f}: bound {:.7f} ({:.0f} % of the gap closed), {} LPs so far\n", round, cut, b,
+               100 * (1 - std::abs(b - extreme) / std::abs(bound - extreme)), lps);
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"Sensitivity of an exact-set endpoint's LP bound to each range of the box"};
   std::string result_path, parameter = "gamma2", solver_name = "ipm", ratio_name = "largest";
@@ -82,37 +129,7 @@ int main(int argc, char** argv) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (bound_only) return 0;
   if (slab > 0.0) {
-    // The slab beyond extreme + slab * gap: is it empty, or how far does it reach, once every other range is
-    // bounded inside it?
-    ex::ParamBox b = box;
-    const double cut = extreme[p] + slab * (b0 - extreme[p]);
-    if (maximise) b[p] = ex::Interval(cut, b0);
-    else b[p] = ex::Interval(b0, cut);
-    int lps = 0;
-    for (int round = 1; round <= rounds; ++round) {
-      for (int k = 0; k < lifted.layout.count(); ++k) {
-        if (k == p) continue;
-        const double before = b[k].hi - b[k].lo;
-        for (bool up : {false, true}) {
-          const auto e = ex::BoundObjective(lifted, b, ex::Objective{k, up}, options, *solver, {}, ratio);
-          lps += e.lps;
-          if (e.verdict == ex::BoxVerdict::kPruned) {
-            fmt::print("round {}: the slab beyond {:.7f} is empty (pruned while bounding {}), {} LPs\n", round, cut,
-                       names[k], lps);
-            return 0;
-          }
-          if (!e.bound) continue;
-          if (up) b[k].hi = std::max(b[k].lo, std::min(b[k].hi, *e.bound));
-          else b[k].lo = std::min(b[k].hi, std::max(b[k].lo, *e.bound));
-        }
-        ex::PropagateForms(lifted, b);
-        fmt::print("round {}: {} keeps {:.2f} of its width in the slab\n", round, names[k], (b[k].hi - b[k].lo) / before);
-      }
-      const auto [bs, l] = bound_on(b);
-      lps += l;
-      fmt::print("round {}: slab beyond {:.7f}: bound {:.7f} ({:.0f} % of the gap closed), {} LPs so far\n", round, cut,
-                 bs, 100 * (1 - std::abs(bs - extreme[p]) / std::abs(b0 - extreme[p])), lps);
-    }
+    ProbeSlab({lifted, options, *solver, ratio}, box, objective, extreme[p], b0, slab, rounds);
     return 0;
   }
   std::vector<double> at = extreme;
