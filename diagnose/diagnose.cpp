@@ -110,11 +110,12 @@ struct Context {
   Vec IdentResidual(const AugmentedModel& m) const { return Residual(ident.y, m.simulate(ident.u)); }
   // The validation test with the recordings' roles swapped: the model refitted on the validation
   // recording, its residual on the identification recording (initial state re-estimated there).
-  Vec SwappedResidual(const AugmentedModel& m) const {
+  AugmentedModel SwappedModel(const AugmentedModel& m) const {
     AugmentedModel r = RefitModel(m, validation, o.refit).model;
     EstimateInitialState(&r, full, o.refit);
-    return Residual(ident.y, r.simulate(ident.u));
+    return r;
   }
+  Vec SwappedResidual(const AugmentedModel& m) const { return IdentResidual(SwappedModel(m)); }
   // Penalty factor for k extra parameters scored on ns samples: FPE on the fitting part, BIC-like on the scored part.
   double Penalty(int k, std::size_t ns) const {
     const double nf = static_cast<double>(nfit - skip), nsd = static_cast<double>(std::max<std::size_t>(ns, 2));
@@ -198,6 +199,26 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
   }
 }
 
+// The swapped test's model (refitted on validation) scored on the identification recording with its
+// blocks removed: a better optimum of a poorly determined nominal, reached by refitting it under any
+// block, passes that test as well; the blocks must make a significant difference there themselves.
+bool SwappedBlocksNeeded(const Context& c, const AugmentedModel& swapped) {
+  AugmentedModel bare = swapped;
+  bare.blocks.clear();
+  EstimateInitialState(&bare, c.full, c.o.refit);
+  return c.Compare(c.IdentResidual(bare), c.IdentResidual(swapped), c.skip, c.n, 0, c.o.validation_z).significant;
+}
+
+// The swapped test stands in for the held-out tail, not for the identification recording as a whole:
+// the candidate refitted on the whole identification recording must lower the error there too
+// (penalised for its parameters), or the identification recording shows nothing of the effect and
+// only the validation recording's disagreement with the nominal (a poorly determined map extrapolated
+// to new input levels) speaks for it.
+bool SeenOnIdentification(const Context& c, const Reference& ref, const Finding& f) {
+  return c.Compare(c.IdentResidual(ref.full), c.IdentResidual(f.model), c.skip, c.n, f.extra_parameters, 0.0).score >=
+         c.o.min_improvement;
+}
+
 Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
   // Saturation-type blocks: one-sided and two-sided limits are different structures, chosen by the
   // penalised held-out score (a second limit must earn its parameter).
@@ -238,10 +259,13 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   Comparison first = f.holdout;
   if (!f.holdout.significant && f.validation.significant && f.validation.score >= c.o.swapped_min_improvement &&
       !ref.swapped_residual.empty()) {
-    f.swapped = c.Compare(ref.swapped_residual, c.SwappedResidual(f.model), c.skip, c.n, f.extra_parameters,
+    const AugmentedModel swapped = c.SwappedModel(f.model);
+    f.swapped = c.Compare(ref.swapped_residual, c.IdentResidual(swapped), c.skip, c.n, f.extra_parameters,
                           c.o.validation_z);
     f.swapped_tested = true;
-    if (f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement) first = f.swapped;
+    if (f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement && SwappedBlocksNeeded(c, swapped) &&
+        SeenOnIdentification(c, ref, f))
+      first = f.swapped;
   }
   const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
   f.score = 1.0 - std::sqrt(ph * pv);
@@ -746,8 +770,28 @@ void Locate(const Context& c, bool verdict, const Vec& e_nom, const Vec& v_refit
   r->region = CharacteriseRegion(r->conditions, r->mask, weight, c.skip, verdict ? "change" : "error");
 }
 
+// Does a candidate's improvement come from its blocks, or only from the nominal part refitted under them?
+// The candidate's models with their blocks removed (nominal parameters kept as fitted with them) are
+// scored on the held-out tail and on validation: the blocks are needed when removing them makes either
+// significantly worse. A nominal stuck in a poor optimum can be freed by any block's refit (an input
+// quantizer of a small step "explaining" a null recording's excess while its nominal part alone reaches
+// the noise); such a gain is a failed nominal fit, not an effect. Fills the bare nominal's held-out RMSE.
+bool BlocksNeeded(const Context& c, const Finding& f, double* bare_holdout_rmse) {
+  AugmentedModel bare_fitted = f.fitted, bare_model = f.model;
+  bare_fitted.blocks.clear();
+  bare_model.blocks.clear();
+  const Vec e_bare = c.IdentResidual(bare_fitted);
+  *bare_holdout_rmse = std::sqrt(Mse(e_bare, c.nfit, c.n));
+  if (!std::isfinite(*bare_holdout_rmse)) return true;
+  const Comparison held = c.Compare(e_bare, c.IdentResidual(f.fitted), c.nfit, c.n, 0, c.o.significance_z);
+  const Comparison valid = c.Compare(c.ValidationResidual(bare_model), c.ValidationResidual(f.model), c.skip, c.nv, 0,
+                                     c.o.validation_z);
+  return held.significant || valid.significant;
+}
+
 // Did the baseline reach the noise floor on the held-out tail? When it did not, a verdict is kept only
-// if it explains at least half of the excess mean square (held-out tail or validation); otherwise the fit
+// if it explains at least half of the excess mean square (held-out tail or validation) and its blocks,
+// not only the nominal part refitted under them, make the difference (BlocksNeeded); otherwise the fit
 // failed and no effect is named.
 const Finding* JudgeNominal(const Context& c, const Reference& base, const Finding* verdict, DiagnoseReport* r) {
   const double sigma = r->noise_std;
@@ -774,7 +818,9 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
     if (valid_excess > 0)
       explained = std::max(explained, (verdict->validation.mse_baseline - verdict->validation.mse) / valid_excess);
   }
-  if (verdict && explained >= 0.5) {
+  double bare_rmse = 0.0;
+  const bool needed = verdict && explained >= 0.5 ? BlocksNeeded(c, *verdict, &bare_rmse) : true;
+  if (verdict && explained >= 0.5 && needed) {
     r->nominal_status = NominalStatus::kExplainedByEffect;
     r->nominal_status_note = fmt::format("the nominal alone stays above the noise floor (held-out RMSE {:.4g} = {:.2f} x the "
                                          "noise {:.4g}); the verdict explains {:.0f} % of the excess mean square",
@@ -787,8 +833,12 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
       "nominal fit failed: held-out RMSE {:.4g} = {:.2f} x the noise {:.4g} (more than {:.2g} x) and {}; no effect is "
       "named on a nominal that does not explain the recording",
       r->baseline_holdout_rmse, r->baseline_holdout_rmse / sigma, sigma, c.o.noise_floor_factor,
-      verdict ? fmt::format("the best candidate, {}, explains only {:.0f} % of the excess", verdict->Label(), 100 * explained)
-              : "no candidate explains the excess");
+      !verdict ? std::string("no candidate explains the excess")
+      : needed ? fmt::format("the best candidate, {}, explains only {:.0f} % of the excess", verdict->Label(), 100 * explained)
+               : fmt::format("the best candidate, {}, explains it only through the nominal part refitted under it: without "
+                             "its blocks that nominal part reaches held-out RMSE {:.4g} = {:.2f} x the noise, so the "
+                             "nominal fit is in a poor optimum",
+                             verdict->Label(), bare_rmse, bare_rmse / sigma));
   return nullptr;
 }
 

@@ -20,7 +20,8 @@
 //     it is significant on the held-out tail (z >= significance_z, penalised reduction >=
 //     min_improvement) and on validation (z >= validation_z, reduction >= min_improvement); when only
 //     validation is, the first test is repeated with the recordings' roles swapped (refit on validation,
-//     scored on identification, as strict as validation) and stands in for the held-out one; the
+//     scored on identification, as strict as validation; the blocks must matter in that refit and the
+//     whole-recording refit must lower the identification error) and stands in for the held-out one; the
 //     verdict is the eligible candidate with the best combined (geometric-mean) penalised score. When only
 //     one of the two tests confirms a candidate, the other fit is restarted from the confirmed one (and,
 //     on the whole recording, from the block's grid) and kept when its own training cost drops.
@@ -89,11 +90,12 @@ struct DiagnoseOptions {
   double min_improvement = 0.05;      // minimum penalised MSE reduction (fraction), held-out and validation
   double validation_z = 2.0;          // validation paired test threshold
   // Penalised reduction a candidate needs on validation and with the recordings' roles swapped when the
-  // held-out tail does not confirm it; 1 = off (the default). On development seeds, 0.3 named 3 effects
-  // that reached 0.33-0.88 on validation but nothing on the tail, and also named an effect on 1 of 60
-  // null recordings with a fitted nominal (0.78 / 0.80 through a better optimum of a cubic input map
-  // under a two-level input): too close to the 2 % false-alarm budget to be the default.
-  double swapped_min_improvement = 1.0;
+  // held-out tail does not confirm it; 1 = off. The swapped test also asks that the blocks themselves
+  // matter in the model refitted on validation (removed, it is significantly worse on identification)
+  // and that the candidate refitted on the whole identification recording lowers its error there:
+  // without these two, 0.3 named an effect on 1 of 60 null recordings with a fitted nominal (a better
+  // optimum of a cubic input map under a two-level input, extrapolated to validation's levels).
+  double swapped_min_improvement = 0.3;
   bool try_pairs = true;              // combinations of two blocks when one leaves a significant misfit
   int pair_partners = 3;              // candidates tried as the second block
   int max_lag = 25;                   // lags of the correlation tests

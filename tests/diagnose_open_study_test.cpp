@@ -1,5 +1,6 @@
 // The second scenario generator (open study), operating-point offsets, feedback detection and the
-// nominal's noise-floor status. Development seeds only (1..99999); the reported study uses 100001..
+// nominal's noise-floor status. Development seeds only (1..99999 and retired reporting ranges); the
+// reported study uses a range never run before.
 #include <cmath>
 #include <iostream>
 #include <set>
@@ -157,6 +158,26 @@ TEST(StictionFit, FindsTheStickSlipJumpThatBacklashCannotDescribe) {
   const auto& p = stiction.model.blocks[0].params;
   EXPECT_LT(p[1], 0.8 * p[0]) << "static " << p[0] << " kinetic " << p[1];
   EXPECT_LT(stiction.sse, 0.95 * backlash.sse);
+}
+
+// A null recording whose fitted nominal stays stuck in a poor optimum (held-out RMSE 2.2x the noise): the
+// refit of an input quantizer of a small step freed the nominal part under it, which alone (the block
+// removed) reaches the noise, and was named as an effect. The blocks must make the difference, otherwise
+// the fit failed (seed 500 252, from a retired reporting range, now development data).
+TEST(NominalStatus, ABlockThatOnlyFreesAStuckNominalIsAFailedFitNotAnEffect) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kNone;
+  so.seed = 500252;
+  const OpenScenario sc = MakeOpenScenario(so);
+  DiagnoseOptions o;
+  o.threads = 1;
+  DiagnoseReport r;
+  Diagnose(o, FitNominalForDiagnosis(sc.structure, sc.ident, o).model, &sc.structure, sc.ident, sc.valid, &r);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_GT(r.baseline_holdout_rmse, 1.2 * sc.noise_std);
+  EXPECT_EQ(r.verdict, Effect::kNone) << r.message;
+  EXPECT_EQ(r.nominal_status, NominalStatus::kFailed) << r.nominal_status_note;
+  EXPECT_NE(r.nominal_status_note.find("poor optimum"), std::string::npos) << r.nominal_status_note;
 }
 
 // Named right on development seeds where the verdict used to be `none`: a delay that a richer numerator
