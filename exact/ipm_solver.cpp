@@ -17,11 +17,6 @@ constexpr int kMaxIterations = 60;
 constexpr int kStallIterations = 10;
 constexpr int kCentralityCorrectors = 2;  // Gondzio's, each one more solve with the same factor
 constexpr double kStepFraction = 0.995;  // of the way to the boundary
-// Regularisation of the normal equations (NormalEquations::Factorize). Measured on 88 lifted LPs of seed 1 at
-// 31 dB that stalled (docs/exact_set.md): 76 solve with these and up to 16 refinement passes, 34 with 1e-10 on
-// the columns and 3 passes.
-constexpr double kColumnRegularisation = 1e-16;
-constexpr double kEqualityRegularisation = 1e-10;
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using Vector = Eigen::VectorXd;
@@ -171,14 +166,13 @@ class NormalEquations {
     llt_.analyzePattern(M_);
   }
 
-  // `column_regularisation` is added to H_x, `row_regularisation` to D_r (the only term of an equality row).
-  bool Factorize(const Vector& h_x, const Vector& d_r, double column_regularisation, double row_regularisation) {
+  bool Factorize(const Vector& h_x, const Vector& d_r, double regularisation) {
     h_x_ = h_x;
     d_r_ = d_r;
-    w_ = (d_r.array() + row_regularisation).inverse().matrix();
+    w_ = (d_r.array() + regularisation).inverse().matrix();
     double* v = M_.valuePtr();
     std::fill(v, v + M_.nonZeros(), 0.0);
-    for (int j = 0; j < f_.n; ++j) v[diagonal_[j]] = h_x[j] + column_regularisation;
+    for (int j = 0; j < f_.n; ++j) v[diagonal_[j]] = h_x[j] + regularisation;
     for (int i = 0; i < f_.m; ++i)
       for (int k = row_begin_[i]; k < row_begin_[i + 1]; ++k) v[pair_position_[k]] += w_[i] * pair_product_[k];
     llt_.factorize(M_);
@@ -186,16 +180,13 @@ class NormalEquations {
   }
 
   // Solves H_x dx - A' dy = fx, -A dx - D_r dy = g (unregularised): the regularised solve, then refinement on
-  // these equations with the same factor until the residual is below kRefinementTolerance of the right-hand
-  // side (at most kMaxRefinements passes). Without it the dual residual stalls at the factor's rounding error
-  // times |M|, and the dual bound stalls with it; near the optimum the lifted LPs need ten passes or more.
+  // these equations with the same factor. Without it the dual residual stalls at the factor's rounding error
+  // times |M|, and the dual bound stalls with it.
   void Solve(const Vector& fx, const Vector& g, Vector* dx, Vector* dy) const {
     SolveRegularised(fx, g, dx, dy);
-    const double tolerance = kRefinementTolerance * (1.0 + fx.lpNorm<Eigen::Infinity>() + g.lpNorm<Eigen::Infinity>());
-    for (int pass = 0; pass < kMaxRefinements; ++pass) {
+    for (int pass = 0; pass < kRefinements; ++pass) {
       const Vector e1 = fx - (h_x_.cwiseProduct(*dx) - f_.A.transpose() * *dy);
       const Vector e2 = g + f_.A * *dx + d_r_.cwiseProduct(*dy);
-      if (std::max(e1.lpNorm<Eigen::Infinity>(), e2.lpNorm<Eigen::Infinity>()) <= tolerance) break;
       Vector cx, cy;
       SolveRegularised(e1, e2, &cx, &cy);
       *dx += cx;
@@ -204,8 +195,7 @@ class NormalEquations {
   }
 
  private:
-  static constexpr int kMaxRefinements = 16;
-  static constexpr double kRefinementTolerance = 1e-12;
+  static constexpr int kRefinements = 3;
 
   void SolveRegularised(const Vector& fx, const Vector& g, Vector* dx, Vector* dy) const {
     *dx = llt_.solve(fx - f_.A.transpose() * w_.cwiseProduct(g));
@@ -489,12 +479,9 @@ class InteriorPoint {
       if (Finite(f_.row_hi[i])) h += it_.zru[i] / (f_.row_hi[i] - it_.r[i]);
       d_r_[i] = 1.0 / h;
     }
-    // Regularisation keeps the factorisation possible: tiny on the columns (an interior column's H_x falls to
-    // 1e-12 near the optimum, and a shift of 1e-10 there is more than the refinement can undo). Both are raised
-    // together until the factorisation succeeds.
+    // Regularisation keeps the quasi-definite factorisation stable; raised until the factorisation succeeds.
     bool factored = false;
-    for (double raise = 1.0; raise <= 1e6 && !factored; raise *= 100)
-      factored = system_.Factorize(h_x, d_r_, kColumnRegularisation * raise, kEqualityRegularisation * raise);
+    for (double reg = 1e-10; reg <= 1e-4 && !factored; reg *= 100) factored = system_.Factorize(h_x, d_r_, reg);
     if (!factored) return false;
     const double mu = Mu();
     const Direction affine = Solve(MehrotraRhs(0.0, nullptr));
