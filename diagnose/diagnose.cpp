@@ -199,12 +199,17 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
   }
 }
 
+// The model's nominal part alone, its parameters as fitted with the blocks.
+AugmentedModel WithoutBlocks(AugmentedModel m) {
+  m.blocks.clear();
+  return m;
+}
+
 // The swapped test's model (refitted on validation) scored on the identification recording with its
 // blocks removed: a better optimum of a poorly determined nominal, reached by refitting it under any
 // block, passes that test as well; the blocks must make a significant difference there themselves.
 bool SwappedBlocksNeeded(const Context& c, const AugmentedModel& swapped) {
-  AugmentedModel bare = swapped;
-  bare.blocks.clear();
+  AugmentedModel bare = WithoutBlocks(swapped);
   EstimateInitialState(&bare, c.full, c.o.refit);
   return c.Compare(c.IdentResidual(bare), c.IdentResidual(swapped), c.skip, c.n, 0, c.o.validation_z).significant;
 }
@@ -263,9 +268,9 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
     f.swapped = c.Compare(ref.swapped_residual, c.IdentResidual(swapped), c.skip, c.n, f.extra_parameters,
                           c.o.validation_z);
     f.swapped_tested = true;
-    if (f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement && SwappedBlocksNeeded(c, swapped) &&
-        SeenOnIdentification(c, ref, f))
-      first = f.swapped;
+    f.swapped_stands_in = f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement &&
+                          SwappedBlocksNeeded(c, swapped) && SeenOnIdentification(c, ref, f);
+    if (f.swapped_stands_in) first = f.swapped;
   }
   const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
   f.score = 1.0 - std::sqrt(ph * pv);
@@ -777,9 +782,7 @@ void Locate(const Context& c, bool verdict, const Vec& e_nom, const Vec& v_refit
 // quantizer of a small step "explaining" a null recording's excess while its nominal part alone reaches
 // the noise); such a gain is a failed nominal fit, not an effect. Fills the bare nominal's held-out RMSE.
 bool BlocksNeeded(const Context& c, const Finding& f, double* bare_holdout_rmse) {
-  AugmentedModel bare_fitted = f.fitted, bare_model = f.model;
-  bare_fitted.blocks.clear();
-  bare_model.blocks.clear();
+  const AugmentedModel bare_fitted = WithoutBlocks(f.fitted), bare_model = WithoutBlocks(f.model);
   const Vec e_bare = c.IdentResidual(bare_fitted);
   *bare_holdout_rmse = std::sqrt(Mse(e_bare, c.nfit, c.n));
   if (!std::isfinite(*bare_holdout_rmse)) return true;
@@ -806,7 +809,7 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
   }
   const double excess = mse_base - sigma * sigma;
   double explained = verdict ? (mse_base - Mse(c.IdentResidual(verdict->fitted), c.nfit, c.n)) / excess : 0.0;
-  if (verdict && verdict->swapped_tested && verdict->swapped.significant && verdict->swapped.score >= c.o.swapped_min_improvement) {
+  if (verdict && verdict->swapped_stands_in) {
     // Confirmed with the roles swapped: the excess is the one of the reference refitted on validation.
     const double swapped_excess = verdict->swapped.mse_baseline - sigma * sigma;
     explained = std::max(explained, swapped_excess > 0 ? (verdict->swapped.mse_baseline - verdict->swapped.mse) / swapped_excess : 1.0);
@@ -819,8 +822,9 @@ const Finding* JudgeNominal(const Context& c, const Reference& base, const Findi
       explained = std::max(explained, (verdict->validation.mse_baseline - verdict->validation.mse) / valid_excess);
   }
   double bare_rmse = 0.0;
-  const bool needed = verdict && explained >= 0.5 ? BlocksNeeded(c, *verdict, &bare_rmse) : true;
-  if (verdict && explained >= 0.5 && needed) {
+  const bool explains_half = verdict && explained >= 0.5;
+  const bool needed = !explains_half || BlocksNeeded(c, *verdict, &bare_rmse);
+  if (explains_half && needed) {
     r->nominal_status = NominalStatus::kExplainedByEffect;
     r->nominal_status_note = fmt::format("the nominal alone stays above the noise floor (held-out RMSE {:.4g} = {:.2f} x the "
                                          "noise {:.4g}); the verdict explains {:.0f} % of the excess mean square",

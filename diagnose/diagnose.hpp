@@ -130,6 +130,7 @@ struct Finding {
   Comparison holdout, validation;
   Comparison swapped;          // roles swapped (refit on validation, scored on identification), see Diagnose
   bool swapped_tested = false; // tried when validation confirms a candidate the held-out tail does not
+  bool swapped_stands_in = false;  // the swapped test passed (with its guards) and replaced the held-out one
   double score = 0.0;        // combined: 1 - sqrt(penalised ratio held-out x penalised ratio validation)
   bool eligible = false;     // significant on both (held-out or swapped), better than the richer nominal, meaningful
   bool beats_richer = true;  // held-out score above the richer nominal's
