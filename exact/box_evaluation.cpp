@@ -171,7 +171,7 @@ bool Usable(const BoundSolve& s) { return s.result.status == LpStatus::kOptimal 
 
 BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
                              const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm,
-                             GammaRatio ratio, int turn) {
+                             GammaRatio ratio, int turn, std::optional<double> ratio_start) {
   const auto start = Clock::now();
   const auto& lay = data.layout;
   const double sign = objective.maximise ? -1.0 : 1.0;  // every LP minimises sign * objective
@@ -214,7 +214,8 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
     Interval abs_b = signed_b(terms.front());  // |B| over the box, > 0 (one term: exact, no rounding)
     for (std::size_t t = 1; t < terms.size(); ++t) abs_b += signed_b(terms[t]);
     const double b_near = abs_b.lo, b_far = abs_b.hi;
-    double g = box[objective.parameter].mid();
+    const Interval& range = box[objective.parameter];
+    double g = ratio_start && range.lo <= *ratio_start && *ratio_start <= range.hi ? *ratio_start : range.mid();
     LpBasis basis = warm;
     std::optional<double> best;
     LpSolveOptions lp = options.lp;  // a gap m in the objective moves the gamma bound by m / |b|
@@ -247,6 +248,9 @@ BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const 
       }
       out.lp_value = beta / bj;
       const double g_next = beta / bj;
+      // The LP's best ratio lies between the ratio reached (g_next, a point of the relaxation) and the certified
+      // bound: once they are within the accuracy asked, more steps cannot tighten the bound by more.
+      if (std::isfinite(g_next) && std::abs(candidate - g_next) <= lp.acceptable_gap / b_near) break;
       // Converged once the ratio moves by less than a millionth of the box: a simplex returns the same vertex
       // and stops at once, an interior point's central solution keeps moving by rounding amounts (without this
       // every box would spend all its steps, and the budget with them).

@@ -70,10 +70,13 @@ BoxEvaluation TestBoxEmpty(const LiftedData& data, const ParamBox& box, const Bo
 // The objective's rigorous bound over the box (min: a lower bound; max: an upper bound). An infeasible LP
 // leads to the emptiness test on the whole record.
 // A gamma_k is bounded as a ratio once some b_j has a sign over the box: `ratio` says which ratio, `turn` which
-// b_j (with GammaRatio::kRotate: the farthest from zero first, cyclically).
+// b_j (with GammaRatio::kRotate: the farthest from zero first, cyclically). `ratio_start`, when inside the box,
+// is where the ratio's Dinkelbach steps start (a parent box's LP ratio: near the answer, fewer LPs); else the
+// middle of the box.
 BoxEvaluation BoundObjective(const LiftedData& data, const ParamBox& box, const Objective& objective,
                              const BoxEvaluationOptions& options, LpSolver& solver, const LpBasis& warm = {},
-                             GammaRatio ratio = GammaRatio::kLargest, int turn = 0);
+                             GammaRatio ratio = GammaRatio::kLargest, int turn = 0,
+                             std::optional<double> ratio_start = std::nullopt);
 
 // The whole record as a window.
 Window WholeRecord(const LiftedData& data);

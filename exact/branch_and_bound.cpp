@@ -207,7 +207,9 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
       if (out.lps >= options.lp_budget) break;
       // With kRotate children divide a gamma by the next b_j: a box keeps the tighter of its own and its parent's bound.
       const int turn = box.objective_splits + box.dynamics_splits;
-      BoxEvaluation e = BoundObjective(data, box.box, objective, accuracy, solver, box.basis, options.gamma_ratio, turn);
+      const std::optional<double> ratio_start = box.from_lp ? std::optional<double>(box.lp_value) : std::nullopt;
+      BoxEvaluation e =
+          BoundObjective(data, box.box, objective, accuracy, solver, box.basis, options.gamma_ratio, turn, ratio_start);
       out.lps += e.lps;
       out.lp_failures += e.lp_failures;
       if (e.verdict == BoxVerdict::kPruned) {
