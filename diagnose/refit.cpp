@@ -489,11 +489,38 @@ bool FlatAround(const AugmentedModel& m, std::size_t b, std::size_t i, const Seg
   return true;
 }
 
+// Stiction's two bands act jointly: from a backlash start (equal bands) the stick-slip jump opens only
+// when the kinetic band drops below the play the backlash fit settled on (it absorbed some of the
+// sticking) while the static band grows beyond it, and a search of one band at a time, each from the
+// other's current value, does not go there. The two are scanned together (static band 0.5-4 times its
+// value, kinetic band 1-0.1 of the static one; numerator, offset and initial state re-solved); the best
+// pair is kept when it lowers the cost, ties going to the smallest static and the largest kinetic band
+// (the end nearest to backlash, as in the one-band search).
+void SearchStictionBandsJointly(AugmentedModel* m, std::size_t b, const Segment& s, const RefitOptions& o) {
+  const double fs0 = m->blocks[b].params[0];
+  if (!(fs0 > 0)) return;
+  double best = SumSquaredError(*m, s);
+  AugmentedModel kept = *m;
+  constexpr int kStatic = 18, kKinetic = 12;
+  for (int i = 0; i <= kStatic; ++i) {
+    const double fs = fs0 * 0.5 * std::pow(8.0, double(i) / kStatic);
+    for (int k = 0; k <= kKinetic; ++k) {
+      AugmentedModel t = *m;
+      t.blocks[b].params = {fs, fs * (1.0 - 0.9 * k / kKinetic)};
+      SolveNumerator(&t, s, o);
+      const double c = SumSquaredError(t, s);
+      if (std::isfinite(c) && c < best * (1.0 - 1e-9)) best = c, kept = std::move(t);
+    }
+  }
+  *m = std::move(kept);
+}
+
 // Local search of every search-only parameter (and of smooth ones on a flat cost), centred in the run
 // of tied values and repeated while that run reaches the end of the local values; then LM again.
 void SearchBlockParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o, bool* any) {
   for (std::size_t b = 0; b < m->blocks.size(); ++b)
     for (std::size_t i = 0; i < m->blocks[b].params.size(); ++i) {
+      if (m->blocks[b].effect == Effect::kStiction && i == 0) SearchStictionBandsJointly(m, b, s, o);
       const bool smooth = ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i));
       if (smooth && !FlatAround(*m, b, i, s)) continue;
       *any = true;
