@@ -271,6 +271,30 @@ TEST(Refit, ASaturationBetweenTwoInputLevelsIsFoundFromTheGapBetweenThem) {
   EXPECT_LT(r.sse, 2.0 * u.size() * 0.01 * 0.01);
 }
 
+// Stiction whose kinetic band is well below its static band, on steps: the backlash start settles on a
+// play between the two, and only a joint move of both bands (static up, kinetic down) opens the jump.
+TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> level(-1.0, 1.0);
+  std::uniform_int_distribution<int> hold(8, 30);
+  Vec u;
+  while (u.size() < 1000) u.insert(u.end(), hold(rng), level(rng));
+  u.resize(1000);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.8}, {0.2}, 0};
+  truth.blocks.push_back({Effect::kStiction, Location::kInput, {0.4, 0.1}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, 0.005);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
+  const RefitResult r = AddBlock(nominal, Effect::kStiction, Location::kInput, StateVariable::kPosition, seg, {});
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_NEAR(r.model.blocks[0].params[0], 0.4, 0.08);
+  EXPECT_NEAR(r.model.blocks[0].params[1], 0.1, 0.04);
+  EXPECT_LT(r.sse, 2.0 * u.size() * 0.005 * 0.005);
+}
+
 // Under an output quantizer the output offset moves the prediction by whole steps: started a third of a
 // step away from the truth (as a nominal fitted without the quantizer leaves it), LM alone cannot
 // descend the staircase; the offset search puts it back within a tenth of a step.
