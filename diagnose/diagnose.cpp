@@ -483,14 +483,23 @@ bool BetterNominalFromCandidates(const Context& c, const std::vector<Finding>& f
   return true;
 }
 
+// Whether a stiction block has a stick-slip jump (kinetic band more than 2 % below the static band).
+bool HasStickSlipJump(const EffectBlock& b) {
+  return b.effect == Effect::kStiction && b.params[0] - b.params[1] > 0.02 * b.params[0];
+}
+
 // Stiction without a stick-slip jump (kinetic band within 2 % of the static band) is backlash with one
 // more parameter (up to a one-sample stick at fast reversals): when backlash is eligible, it names it.
+// The jump counts when either fit shows it: the fitting part may hold no input move between the two
+// bands (its tie then goes to equal bands) while the whole identification recording does.
 void PreferBacklashToJumplessStiction(std::vector<Finding>* fs) {
   bool backlash = false;
   for (const auto& f : *fs) backlash = backlash || (f.eligible && f.blocks.front().effect == Effect::kBacklash);
   for (auto& f : *fs) {
-    const auto& p = f.blocks.front().params;
-    if (backlash && f.blocks.front().effect == Effect::kStiction && p[0] - p[1] <= 0.02 * p[0]) {
+    if (f.blocks.front().effect != Effect::kStiction) continue;
+    const bool jump = HasStickSlipJump(f.blocks.front()) ||
+                      (!f.model.blocks.empty() && HasStickSlipJump(f.model.blocks.front()));
+    if (backlash && !jump) {
       f.eligible = false;
       f.jumpless_stiction = true;
     }

@@ -232,6 +232,36 @@ bool FreshPolesForDelay(AugmentedModel* m, const Segment& s, const RefitOptions&
   return SolveNumerator(m, s, o);
 }
 
+// Candidate limits of a saturation on signal v: quantiles near its top (upper) or bottom, and infinity.
+// On a signal of few levels (steps, PRBS) a quantile is a level itself, and a limit there clips nothing
+// of it: a limit between that level and the next one further out is a candidate too (the middle of
+// the gap, where a tie between two levels puts it), when the gap is more than 1 % of the range. A
+// finite limit that clips no sample is the baseline itself and no start (LM cannot move it: the cost
+// is flat there), so only limits inside the signal's range are kept.
+Vec LimitCandidates(const Vec& v, bool upper) {
+  const Vec qs = {0.002, 0.005, 0.01, 0.02, 0.04, 0.07, 0.1, 0.15, 0.2, 0.3};
+  const double range = Quantile(v, 1.0) - Quantile(v, 0.0);
+  Vec sorted = v;
+  std::sort(sorted.begin(), sorted.end());
+  Vec out = {upper ? HUGE_VAL : -HUGE_VAL};
+  for (double q : qs) {
+    const double level = Quantile(v, upper ? 1 - q : q);
+    out.push_back(level);
+    // The next value of the signal beyond the level (outwards).
+    const auto it = upper ? std::upper_bound(sorted.begin(), sorted.end(), level) : std::lower_bound(sorted.begin(), sorted.end(), level);
+    if (upper ? it == sorted.end() : it == sorted.begin()) continue;
+    const double next = upper ? *it : *(it - 1);
+    if (std::abs(next - level) > 0.01 * range) out.push_back(0.5 * (level + next));
+  }
+  const double lowest = Quantile(v, 0.0), highest = Quantile(v, 1.0);
+  out.erase(std::remove_if(out.begin(), out.end(),
+                           [&](double x) { return std::isfinite(x) && (upper ? x >= highest : x <= lowest); }),
+            out.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 // Grid of the new block's parameters, scaled to the recording and to the current simulation.
 std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, const Vec& zhat, const HwModel& nominal) {
   std::vector<Vec> g;
@@ -256,12 +286,7 @@ std::vector<Vec> EffectGrid(Effect e, Location l, const Vec& u, const Vec& y, co
     }
     case Effect::kSaturation:
     case Effect::kStateSaturation: {
-      const Vec qs = {0.002, 0.005, 0.01, 0.02, 0.04, 0.07, 0.1, 0.15, 0.2, 0.3};
-      Vec lo = {-HUGE_VAL}, hi = {HUGE_VAL};
-      for (double q : qs) {
-        lo.push_back(Quantile(v, q));
-        hi.push_back(Quantile(v, 1 - q));
-      }
+      const Vec lo = LimitCandidates(v, false), hi = LimitCandidates(v, true);
       for (double a : lo)
         for (double b : hi)
           if (a < b && (std::isfinite(a) || std::isfinite(b))) g.push_back({a, b});
@@ -489,11 +514,38 @@ bool FlatAround(const AugmentedModel& m, std::size_t b, std::size_t i, const Seg
   return true;
 }
 
+// Stiction's two bands act jointly: from a backlash start (equal bands) the stick-slip jump opens only
+// when the kinetic band drops below the play the backlash fit settled on (it absorbed some of the
+// sticking) while the static band grows beyond it, and a search of one band at a time, each from the
+// other's current value, does not go there. The two are scanned together (static band 0.5-4 times its
+// value, kinetic band 1-0.1 of the static one; numerator, offset and initial state re-solved); the best
+// pair is kept when it lowers the cost, ties going to the smallest static and the largest kinetic band
+// (the end nearest to backlash, as in the one-band search).
+void SearchStictionBandsJointly(AugmentedModel* m, std::size_t b, const Segment& s, const RefitOptions& o) {
+  const double fs0 = m->blocks[b].params[0];
+  if (!(fs0 > 0)) return;
+  double best = SumSquaredError(*m, s);
+  AugmentedModel kept = *m;
+  constexpr int kStatic = 18, kKinetic = 12;
+  for (int i = 0; i <= kStatic; ++i) {
+    const double fs = fs0 * 0.5 * std::pow(8.0, double(i) / kStatic);
+    for (int k = 0; k <= kKinetic; ++k) {
+      AugmentedModel t = *m;
+      t.blocks[b].params = {fs, fs * (1.0 - 0.9 * k / kKinetic)};
+      SolveNumerator(&t, s, o);
+      const double c = SumSquaredError(t, s);
+      if (std::isfinite(c) && c < best * (1.0 - 1e-9)) best = c, kept = std::move(t);
+    }
+  }
+  *m = std::move(kept);
+}
+
 // Local search of every search-only parameter (and of smooth ones on a flat cost), centred in the run
 // of tied values and repeated while that run reaches the end of the local values; then LM again.
 void SearchBlockParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o, bool* any) {
   for (std::size_t b = 0; b < m->blocks.size(); ++b)
     for (std::size_t i = 0; i < m->blocks[b].params.size(); ++i) {
+      if (m->blocks[b].effect == Effect::kStiction && i == 0) SearchStictionBandsJointly(m, b, s, o);
       const bool smooth = ParameterIsSmooth(m->blocks[b].effect, static_cast<int>(i));
       if (smooth && !FlatAround(*m, b, i, s)) continue;
       *any = true;

@@ -239,6 +239,62 @@ TEST(Refit, AThresholdBetweenTwoInputLevelsIsPlacedInsideTheInterval) {
   EXPECT_NEAR(r.model.blocks[0].params[1], 0.3, 0.03);
 }
 
+// Random steps over a few levels (holds of 8-30 samples).
+Vec FewLevelSteps(std::mt19937_64& rng, const Vec& levels, std::size_t n) {
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(levels.size()) - 1), hold(8, 30);
+  Vec u;
+  while (u.size() < n) u.insert(u.end(), hold(rng), levels[pick(rng)]);
+  u.resize(n);
+  return u;
+}
+
+// A saturation whose limit lies between the two top levels of a step input: every quantile of the
+// input is a level, and a limit at a level clips nothing of it. With a nominal fitted without the block
+// (its cubic output map absorbed part of the clipping, and no numerator can be re-solved under it), the
+// grid points at the levels are no better than the baseline; the limit between the levels is a start.
+TEST(Refit, ASaturationBetweenTwoInputLevelsIsFoundFromTheGapBetweenThem) {
+  std::mt19937_64 rng(21);
+  const Vec u = FewLevelSteps(rng, {-1.0, -0.6, -0.2, 0.2, 0.6, 1.0}, 1000);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.8}, {0.2}, 0};
+  truth.nominal.output = StaticMap::Polynomial({1.0, 0.1, 0.2});
+  truth.blocks.push_back({Effect::kSaturation, Location::kInput, {-HUGE_VAL, 0.8}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, 0.01);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
+  const RefitResult r = AddBlock(nominal, Effect::kSaturation, Location::kInput, StateVariable::kPosition, seg, {});
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_GT(r.model.blocks[0].params[1], 0.65);
+  EXPECT_LT(r.model.blocks[0].params[1], 0.95);
+  EXPECT_LT(r.sse, 2.0 * u.size() * 0.01 * 0.01);
+}
+
+// Stiction whose kinetic band is well below its static band, on steps: the backlash start settles on a
+// play between the two, and only a joint move of both bands (static up, kinetic down) opens the jump.
+TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> level(-1.0, 1.0);
+  std::uniform_int_distribution<int> hold(8, 30);
+  Vec u;
+  while (u.size() < 1000) u.insert(u.end(), hold(rng), level(rng));
+  u.resize(1000);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.8}, {0.2}, 0};
+  truth.blocks.push_back({Effect::kStiction, Location::kInput, {0.4, 0.1}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, 0.005);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
+  const RefitResult r = AddBlock(nominal, Effect::kStiction, Location::kInput, StateVariable::kPosition, seg, {});
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_NEAR(r.model.blocks[0].params[0], 0.4, 0.08);
+  EXPECT_NEAR(r.model.blocks[0].params[1], 0.1, 0.04);
+  EXPECT_LT(r.sse, 2.0 * u.size() * 0.005 * 0.005);
+}
+
 // Under an output quantizer the output offset moves the prediction by whole steps: started a third of a
 // step away from the truth (as a nominal fitted without the quantizer leaves it), LM alone cannot
 // descend the staircase; the offset search puts it back within a tenth of a step.
