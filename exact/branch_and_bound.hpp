@@ -53,7 +53,7 @@ int SplitEntry(const LiftedData& data, const ParamBox& box, const ParamBox& star
                const ParamBox* scale = nullptr);
 
 struct ObjectiveSearchOptions {
-  int lp_budget = 24;              // LPs of one endpoint's refinement
+  int lp_budget = 10;              // LPs of one endpoint's refinement (per sweep)
   EndpointSplit split = EndpointSplit::kDynamics;
   GammaRatio gamma_ratio = GammaRatio::kLargest;  // how a gamma's bound divides by the b_j (box_evaluation.hpp)
   double min_relative_width = 1e-9;  // a box narrower than this (relative to the start box) is not halved

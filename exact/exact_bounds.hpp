@@ -44,7 +44,7 @@ struct ExactBoundsOptions {
   BoxEvaluationOptions evaluation;
   PruneStop prune;
   ObjectiveSearchOptions search;
-  int sweeps = 2;                 // bounding sweeps; each after the first starts in the box the previous proved
+  int sweeps = 4;                 // bounding sweeps; each after the first starts in the box the previous proved
   // Bound and halve forms across D's thin directions in (a_1..a_na) too (exact/dynamics_forms.hpp).
   bool dynamics_forms = true;
   DynamicsFormOptions forms;

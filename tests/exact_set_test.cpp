@@ -84,6 +84,35 @@ TEST(LiftedLp, TheTruthsBoxIsNeverProvenEmptyAndABoxFarAwayIs) {
   EXPECT_GT(e.certificate->residual_lower_bound, 0.0);
 }
 
+// A gamma's bound is a ratio found by Dinkelbach steps (one LP each). Started from the ratio a first evaluation
+// reached — what a child box inherits from its parent — one LP certifies the same bound to the accuracy asked.
+TEST(BoxEvaluation, AGammaRatioStartedNearItsAnswerNeedsOneLp) {
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    const auto inst = InstanceOf(seed, 80);
+    const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+    if (d.layout.num_gamma == 0) continue;
+    const ParamBox box = BoxAround(d, inst.theta, 1e-3, 0.05);
+    bool b_signed = false;  // the ratio needs some b_j of one sign over the box
+    for (int k = d.layout.b_begin; k < d.layout.count(); ++k) b_signed |= box[k].lo > 0 || box[k].hi < 0;
+    if (!b_signed) continue;
+    ClpSolver clp;
+    BoxEvaluationOptions ev;
+    ev.cheap_window = 0;
+    const Objective max_gamma{d.layout.gamma_begin, true};
+    const BoxEvaluation from_middle = BoundObjective(d, box, max_gamma, ev, clp);
+    ASSERT_TRUE(from_middle.bound.has_value()) << inst.description;
+    ASSERT_GE(from_middle.lps, 2) << inst.description;  // the middle of the box is not the answer
+    const BoxEvaluation from_answer =
+        BoundObjective(d, box, max_gamma, ev, clp, {}, GammaRatio::kLargest, 0, from_middle.lp_value);
+    ASSERT_TRUE(from_answer.bound.has_value()) << inst.description;
+    EXPECT_EQ(from_answer.lps, 1) << inst.description;
+    EXPECT_NEAR(*from_answer.bound, *from_middle.bound, 1e-4 * (box[max_gamma.parameter].hi - box[max_gamma.parameter].lo));
+    EXPECT_GE(*from_answer.bound, inst.theta[max_gamma.parameter]) << inst.description;
+    return;
+  }
+  FAIL() << "no random instance with a gamma and a signed b_j in seeds 1-40";
+}
+
 TEST(LpBackends, ClpAndGlpkAgreeOnTheOptimumAndBothDualsCertify) {
   const auto inst = InstanceOf(11, 80);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
