@@ -299,18 +299,7 @@ class InteriorPoint {
 
   // The Lagrangian dual bound min over the column box and the row bounds of c'x - y'(Ax - r), with y clamped to
   // the sign its row's finite bound allows (the same clamp as the certificate), in floating point.
-  double DualObjective() const {
-    Vector y = it_.y;
-    double total = 0.0;
-    for (int i = 0; i < f_.m; ++i) {
-      if (y[i] > 0 && Finite(f_.row_lo[i])) total += y[i] * f_.row_lo[i];
-      else if (y[i] < 0 && Finite(f_.row_hi[i])) total += y[i] * f_.row_hi[i];
-      else y[i] = 0.0;
-    }
-    const Vector reduced = f_.c - At_ * y;
-    for (int j = 0; j < f_.n; ++j) total += reduced[j] * (reduced[j] > 0 ? f_.col_lo[j] : f_.col_hi[j]);
-    return total + f_.fixed_objective;
-  }
+  double DualObjective() const { return LagrangianBound(it_.y, f_.c, nullptr) + f_.fixed_objective; }
   double PrimalObjective() const { return f_.c.dot(it_.x) + f_.fixed_objective; }
 
   // Whether y, as a Farkas vector, shows in floating point that no x in the column box meets the rows: the
@@ -321,17 +310,26 @@ class InteriorPoint {
   bool ProvesInfeasible(const Vector& y_in) const {
     const double norm = y_in.lpNorm<Eigen::Infinity>();
     if (!(norm > 0) || !std::isfinite(norm)) return false;
-    Vector y = y_in / norm;
-    double total = 0.0, magnitude = 0.0;
-    auto add = [&](double term) { total += term, magnitude += std::abs(term); };
+    double magnitude = 0.0;
+    const double total = LagrangianBound(y_in / norm, Vector::Zero(f_.n), &magnitude);
+    return total > kFarkasMargin * magnitude;
+  }
+
+  // min over the column box and the row bounds of c'x - y'(Ax - r) (without the fixed columns' constant), with
+  // y clamped to the sign its row's finite bound allows (the same clamp as the certificate), in floating point.
+  // `magnitude`, when given, receives the sum of the terms' absolute values.
+  double LagrangianBound(Vector y, const Vector& c, double* magnitude) const {
+    double total = 0.0, size = 0.0;
+    auto add = [&](double term) { total += term, size += std::abs(term); };
     for (int i = 0; i < f_.m; ++i) {
       if (y[i] > 0 && Finite(f_.row_lo[i])) add(y[i] * f_.row_lo[i]);
       else if (y[i] < 0 && Finite(f_.row_hi[i])) add(y[i] * f_.row_hi[i]);
       else y[i] = 0.0;
     }
-    const Vector reduced = -(At_ * y);
+    const Vector reduced = c - At_ * y;
     for (int j = 0; j < f_.n; ++j) add(reduced[j] * (reduced[j] > 0 ? f_.col_lo[j] : f_.col_hi[j]));
-    return total > kFarkasMargin * magnitude;
+    if (magnitude) *magnitude = size;
+    return total;
   }
 
  private:
