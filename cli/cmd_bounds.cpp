@@ -310,7 +310,8 @@ void AddBoundsCommand(CLI::App& app) {
                   "inverse output map increases on the data range")
       ->check(CLI::IsMember({"dss", "exact"}));
   cmd->add_option("--lp-budget", o->lp_budget, "--set exact: LPs per endpoint refinement (>= 1)");
-  cmd->add_option("--sweeps", o->sweeps, "--set exact: bounding sweeps, each in the box the previous proved (1..5)");
+  cmd->add_option("--sweeps", o->sweeps, "--set exact: bounding sweeps at most, each in the box the previous proved; they stop once every "
+                  "interval is within 1.25 times its inner hull (1..5)");
   cmd->add_option("--lp-solver", o->lp_solver, "--set exact: the LP backend, clp, glpk, ipm or ipm-only (certificates do not depend on it)")
       ->check(CLI::IsMember(exact::AvailableLpSolvers()));
   cmd->add_option("--json", o->json_out, "write the result as JSON");

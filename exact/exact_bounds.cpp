@@ -164,10 +164,11 @@ bool GammaWithoutDenominator(const LiftedData& data, const ParamBox& box, int k)
 }
 
 // Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter and form)
-// refined. The forms' new ranges go to `form_ranges`.
+// refined. The forms' new ranges go to `form_ranges`. With `closing_budget`: only the endpoints still short of
+// their target, each with that budget.
 void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
-                const InnerRanges* inner, double target_ratio, EndpointSplit split, JobRunner& runner,
-                ExactBoundsSummary& s,
+                const InnerRanges* inner, double target_ratio, EndpointSplit split, std::optional<int> closing_budget,
+                JobRunner& runner, ExactBoundsSummary& s,
                 std::vector<ExactInterval>& intervals, std::vector<Interval>& form_ranges, bool forms_only,
                 const std::function<void(int, int)>& on_done) {
   const auto& lay = data.layout;
@@ -182,6 +183,8 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
   }
   for (int k = forms_only ? lay.count() : 0; k < static_cast<int>(start.size()); ++k)
     for (bool maximise : {false, true}) {
+      const bool closing = closing_budget && k < lay.count() && !GammaWithoutDenominator(data, start, k);
+      if (closing_budget && !(closing && ShortOfTarget(intervals[k], maximise, target_ratio))) continue;
       std::optional<double> target;
       double gap = 0.0;
       if (inner && (*inner)[k]) {
@@ -191,10 +194,10 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
         gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
       }
       objectives.push_back({k, maximise});
-      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms,
-                                       GammaWithoutDenominator(data, start, k) ? std::optional<int>(kUnsignedGammaBudget)
-                                                                               : std::nullopt,
-                                       scale));
+      std::optional<int> budget;
+      if (closing) budget = closing_budget;
+      else if (GammaWithoutDenominator(data, start, k)) budget = kUnsignedGammaBudget;
+      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms, budget, scale));
     }
   const auto answers = runner.Run(specs, on_done);
   for (std::size_t o = 0; o < objectives.size(); ++o) {
@@ -264,6 +267,30 @@ std::string MonotoneAssumptionText() {
          "[min(y - dy), max(y + dy)] (paper 001 takes it invertible; alpha_1 = 1 fixes the sign)";
 }
 
+bool ShortOfTarget(const ExactInterval& interval, bool maximise, double target_ratio) {
+  if (!interval.inner) return true;
+  const auto [lo, hi] = *interval.inner;
+  const double gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
+  return maximise ? interval.upper.value > hi + gap : interval.lower.value < lo - gap;
+}
+
+bool NoneShortOfTarget(const std::vector<ExactInterval>& intervals, double target_ratio) {
+  for (const auto& iv : intervals)
+    if (ShortOfTarget(iv, false, target_ratio) || ShortOfTarget(iv, true, target_ratio)) return false;
+  return true;
+}
+
+int ShortEndpointBudget(const std::vector<ExactInterval>& intervals, double target_ratio, int lp_budget, int cap) {
+  int endpoints = 0, short_ones = 0;
+  for (const auto& iv : intervals)
+    for (bool maximise : {false, true}) {
+      ++endpoints;
+      if (ShortOfTarget(iv, maximise, target_ratio)) ++short_ones;
+    }
+  if (short_ones == 0) return lp_budget;
+  return lp_budget * std::clamp(endpoints / short_ones, 1, cap);
+}
+
 bool ExactBoundsOptions::IsValid(std::string* error) const {
   auto fail = [&](std::string m) {
     if (error) *error = std::move(m);
@@ -274,6 +301,8 @@ bool ExactBoundsOptions::IsValid(std::string* error) const {
   if (dynamics_forms && !forms.IsValid(error)) return false;
   if (sweeps < 1 || sweeps > 5) return fail(fmt::format("sweeps must be 1..5, not {}", sweeps));
   if (!(target_ratio >= 1.0)) return fail("target_ratio must be >= 1");
+  if (short_endpoint_budget_cap < 1)
+    return fail(fmt::format("short_endpoint_budget_cap must be >= 1 (1 = off), not {}", short_endpoint_budget_cap));
   if (threads < 0) return fail("threads must be >= 0 (0 = one per core)");
   if (inner_hull && !inner.IsValid(error)) return false;
   return true;
@@ -301,7 +330,7 @@ nlohmann::json ExactBoundsSummary::to_json() const {
           {"certificates", certificates},
           {"assumption", assumption.to_json()},
           {"stage2",
-           {{"prune_levels", prune_levels}, {"boxes_evaluated", boxes_evaluated}, {"boxes_pruned", boxes_pruned},
+           {{"prune_levels", prune_levels}, {"sweeps", sweeps}, {"closing_pass", closing_pass}, {"boxes_evaluated", boxes_evaluated}, {"boxes_pruned", boxes_pruned},
             {"boxes_live", boxes_live}, {"lps", lps}, {"lp_failures", lp_failures}, {"jobs", jobs},
             {"jobs_from_cache", jobs_from_cache}, {"lp_rows", lp_rows}, {"lp_cols", lp_cols},
             {"lp_nonzeros", lp_nonzeros}, {"prune_seconds", prune_seconds}, {"inner_seconds", inner_seconds},
@@ -421,9 +450,15 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
   std::vector<Interval> form_ranges(with_forms.dynamics_forms.size(), Interval(-INFINITY, INFINITY));
   // The forms' own ranges first (sweep 0): every endpoint's search then starts with D's strip already narrow,
   // instead of each one cutting it down on its own.
-  for (int sweep = form_ranges.empty() ? 1 : 0; sweep <= options.sweeps; ++sweep) {
-    const std::string phase = sweep == 0 ? std::string("bound (the dynamics forms)")
-                                         : fmt::format("bound (sweep {} of {}, endpoints)", sweep, options.sweeps);
+  // After the sweeps, a closing pass for the endpoints still short of their target (sweep options.sweeps + 1).
+  const bool closing_pass = inner_ranges && options.short_endpoint_budget_cap > 1;
+  for (int sweep = form_ranges.empty() ? 1 : 0; sweep <= options.sweeps + (closing_pass ? 1 : 0); ++sweep) {
+    // Every endpoint within its target: a further sweep would narrow what needs no narrowing.
+    if (sweep >= 2 && inner_ranges && NoneShortOfTarget(s.intervals, options.target_ratio)) break;
+    const bool closing = sweep > options.sweeps;
+    const std::string phase = sweep == 0   ? std::string("bound (the dynamics forms)")
+                              : closing    ? std::string("bound (closing pass, the endpoints short of their target)")
+                                           : fmt::format("bound (sweep {} of {}, endpoints)", sweep, options.sweeps);
     ParamBox sweep_start = start_box;
     for (int k = 0; k < lay.count(); ++k) sweep_start[k] = Interval(s.intervals[k].lower.value, s.intervals[k].upper.value);
     sweep_start = WithFormRanges(with_forms, sweep_start);
@@ -435,8 +470,17 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     // Each endpoint's search starts from the live hull (one box): it halves only where its bound is worst, which
     // costs fewer LPs than bounding every live box of the pruning search first.
     const std::vector<ParamBox> sweep_boxes = {sweep_start};
+    std::optional<int> closing_budget;
+    if (closing) {
+      closing_budget = ShortEndpointBudget(s.intervals, options.target_ratio, options.search.lp_budget,
+                                           options.short_endpoint_budget_cap);
+      s.closing_pass = true;
+    } else if (sweep >= 1) {
+      s.sweeps = sweep;
+    }
     BoundSweep(with_forms, sweep_start, sweep_boxes, inner_ranges ? &*inner_ranges : nullptr, options.target_ratio,
-               options.search.split, runner, s, s.intervals, form_ranges, sweep == 0, [&](int done, int total) {
+               options.search.split, closing_budget, runner, s, s.intervals, form_ranges, sweep == 0,
+               [&](int done, int total) {
                  if (progress) progress({phase, done, total, "", SecondsSince(t0)});
                });
   }

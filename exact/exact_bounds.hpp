@@ -44,11 +44,16 @@ struct ExactBoundsOptions {
   BoxEvaluationOptions evaluation;
   PruneStop prune;
   ObjectiveSearchOptions search;
-  int sweeps = 4;                 // bounding sweeps; each after the first starts in the box the previous proved
+  // Bounding sweeps at most; each after the first starts in the box the previous proved. Sweeps stop early once
+  // every endpoint is within target_ratio of the inner hull.
+  int sweeps = 4;
   // Bound and halve forms across D's thin directions in (a_1..a_na) too (exact/dynamics_forms.hpp).
   bool dynamics_forms = true;
   DynamicsFormOptions forms;
   double target_ratio = 1.25;     // stop refining an endpoint once outer/inner width would be at most this
+  // After the sweeps, the endpoints still short of the target get a closing pass with the LPs a sweep would have
+  // given the others: up to this many times search.lp_budget each (1 = no closing pass).
+  int short_endpoint_budget_cap = 4;
   bool inner_hull = true;
   InnerHullOptions inner = NoRestarts();  // restarts measured to cost 15x for no wider range (docs/exact_set.md)
   std::vector<std::string> parameters;  // intervals to compute; empty = all
@@ -98,6 +103,8 @@ struct ExactBoundsSummary {
   bool invalidated = false;                      // every box proven empty
   std::vector<nlohmann::json> certificates;      // of the pruned boxes when invalidated (box + certificate)
   int prune_levels = 0, boxes_evaluated = 0, boxes_pruned = 0, boxes_live = 0;
+  int sweeps = 0;                                // bounding sweeps run (fewer than asked once all are within target)
+  bool closing_pass = false;                     // the endpoints still short of the target had a pass of their own
   int lps = 0, lp_failures = 0, jobs = 0, jobs_from_cache = 0;
   int lp_rows = 0, lp_cols = 0;                  // of the whole-record LP
   long lp_nonzeros = 0;
@@ -114,6 +121,14 @@ struct ExactBoundsSummary {
 ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
                                       const dss::HwData& data, const ParamBox& start_box,
                                       const std::function<void(const ExactBoundsProgress&)>& progress = {});
+
+// Whether an endpoint is farther from its inner hull than outer/inner <= target_ratio allows (no inner hull: yes).
+bool ShortOfTarget(const ExactInterval& interval, bool maximise, double target_ratio);
+bool NoneShortOfTarget(const std::vector<ExactInterval>& intervals, double target_ratio);
+// The LP budget of an endpoint still short of its target in the closing pass: what a sweep would have given every
+// endpoint, shared among the short ones — lp_budget times (endpoints / short ones), at most `cap` times — so the
+// pass never spends more than a sweep's budget.
+int ShortEndpointBudget(const std::vector<ExactInterval>& intervals, double target_ratio, int lp_budget, int cap);
 
 // The assumption's statement, for --help, summaries and JSON.
 std::string MonotoneAssumptionText();

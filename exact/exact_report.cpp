@@ -55,9 +55,9 @@ std::string ExactReport(const ExactBoundsSummary& s, const ExactReportOptions& o
   out += fmt::format("certificates: every pruned box and every bound from a safe LP bound (outward-rounded interval "
                      "arithmetic on the duals); {} LPs ({} did not end optimal and were kept or refined)\n",
                      s.lps, s.lp_failures);
-  out += fmt::format("stage 2: {} levels, {} boxes tested, {} pruned, {} live; LP {} x {} ({} nonzeros); {} jobs on {} "
+  out += fmt::format("stage 2: {} levels, {} boxes tested, {} pruned, {} live; {} sweeps{}; LP {} x {} ({} nonzeros); {} jobs on {} "
                      "({} from the run directory); {:.1f} s (prune {:.1f}, inner hull {:.1f}, bound {:.1f})",
-                     s.prune_levels, s.boxes_evaluated, s.boxes_pruned, s.boxes_live, s.lp_rows, s.lp_cols,
+                     s.prune_levels, s.boxes_evaluated, s.boxes_pruned, s.boxes_live, s.sweeps, s.closing_pass ? " and a closing pass" : "", s.lp_rows, s.lp_cols,
                      s.lp_nonzeros, s.jobs, s.executor, s.jobs_from_cache, s.wall_seconds, s.prune_seconds,
                      s.inner_seconds, s.bound_seconds);
   if (o.stage1_seconds > 0) out += fmt::format("; stage 1 ({}) {:.1f} s", o.outer_label, o.stage1_seconds);

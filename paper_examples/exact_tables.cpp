@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
   int threads = 2, lp_budget = exact::ObjectiveSearchOptions{}.lp_budget, sweeps = exact::ExactBoundsOptions{}.sweeps;
   std::string lp_solver = exact::ExactBoundsOptions{}.lp_solver;
   std::string split = exact::ToString(exact::ObjectiveSearchOptions{}.split);
-  int samples = 0;
+  int samples = 0, seed = 0;
   std::string gamma_ratio = exact::ToString(exact::ObjectiveSearchOptions{}.gamma_ratio);
   std::string run_dir;
   std::vector<std::string> parameters;
@@ -194,9 +194,17 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "fork workers");
   app.add_option("--lp-budget", lp_budget, "LPs per endpoint refinement");
   app.add_option("--sweeps", sweeps, "bounding sweeps")->check(CLI::PositiveNumber);
+  int short_cap = exact::ExactBoundsOptions{}.short_endpoint_budget_cap;
+  app.add_option("--short-budget-cap", short_cap,
+                 "after the sweeps, an endpoint short of the target gets up to this many times --lp-budget (1 = off)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--samples", samples,
                  "another record length than the committed run's (cost against N): the start box is then an assumed "
                  "prior box, not proven for this record")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", seed,
+                 "another noise realisation than the committed run's (a held-out record): the start box is then an "
+                 "assumed prior box, not proven for this record")
       ->check(CLI::PositiveNumber);
   app.add_option("--lp-solver", lp_solver, "LP backend: clp, glpk, ipm or ipm-only")->check([](const std::string& name) {
     std::string error;
@@ -229,8 +237,9 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(out, made);
     if (made) throw InputError(fmt::format("{}: cannot make the output folder ({})", out, made.message()));
     StageOne one = ReadStageOne(tables);
-    const bool box_proven = samples == 0 || samples == one.samples;
+    const bool box_proven = (samples == 0 || samples == one.samples) && (seed == 0 || seed == one.seed);
     if (samples > 0) one.samples = samples;
+    if (seed > 0) one.seed = seed;
     const CeroneExample ex = SimulateCeroneExample(one.seed, one.samples, one.snr_db);
     dss::HwData data;
     data.u = ex.u;
@@ -243,6 +252,7 @@ int main(int argc, char** argv) {
     exact::ParseGammaRatio(gamma_ratio, &options.search.gamma_ratio);
     options.run_dir = run_dir;
     options.sweeps = sweeps;
+    options.short_endpoint_budget_cap = short_cap;
     options.lp_solver = lp_solver;
     options.parameters = parameters;
     const auto s = exact::ComputeExactBounds(options, dss::CeroneExampleStructure(), data, one.box,
@@ -255,17 +265,19 @@ int main(int argc, char** argv) {
         "# Exact set D, seed {}, N = {}, {} dB (realised {:.2f} dB), noise bound {:.6g}\n\n"
         "Start box: D^ss(2) at δ = {} from `{}` (stage 1: {:.0f} s wall in that committed run, which may have read "
         "its jobs from a run cache){}. Command: `exact_tables --tables {} --out {} --threads {} --lp-budget {} "
-        "--sweeps {} --lp-solver {} --split {} --gamma-ratio {}{}`.\n\n",
+        "--sweeps {} --short-budget-cap {} --lp-solver {} --split {} --gamma-ratio {}{}`.\n\n",
         one.seed, one.samples, one.snr_db, ex.snr_db, ex.noise_bound, one.order, tables, one.seconds,
         box_proven ? "" : fmt::format("; that run's record is not this one, so here the box is an assumed prior box "
                                       "(the intervals bound D inside it), not a proven one"),
-        tables, out, threads, lp_budget, sweeps, lp_solver, split, gamma_ratio, box_proven ? "" : fmt::format(" --samples {}", samples));
+        tables, out, threads, lp_budget, sweeps, short_cap, lp_solver, split, gamma_ratio,
+        (samples > 0 ? fmt::format(" --samples {}", samples) : std::string()) +
+            (seed > 0 ? fmt::format(" --seed {}", seed) : std::string()));
     md += Table(s, one, truth);
     md += fmt::format("\nStage 2: {:.1f} s wall on {} (prune {:.1f} s, inner hull {:.1f} s, bound {:.1f} s); {} "
-                      "levels, {} boxes tested, {} pruned; {} LPs of {} x {} ({} nonzeros), {} not optimal. "
+                      "levels, {} boxes tested, {} pruned; {} sweeps{}; {} LPs of {} x {} ({} nonzeros), {} not optimal. "
                       "Assumption on the result: {}.\n",
                       s.wall_seconds, s.executor, s.prune_seconds, s.inner_seconds, s.bound_seconds, s.prune_levels,
-                      s.boxes_evaluated, s.boxes_pruned, s.lps, s.lp_rows, s.lp_cols, s.lp_nonzeros, s.lp_failures,
+                      s.boxes_evaluated, s.boxes_pruned, s.sweeps, s.closing_pass ? " and a closing pass" : "", s.lps, s.lp_rows, s.lp_cols, s.lp_nonzeros, s.lp_failures,
                       s.assumption.holds ? "holds" : "not shown");
     nlohmann::json j = s.to_json();
     j["stage1"] = {{"tables", tables}, {"seconds", one.seconds}, {"start_box_proven_for_this_record", box_proven}};

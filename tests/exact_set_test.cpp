@@ -113,6 +113,36 @@ TEST(BoxEvaluation, AGammaRatioStartedNearItsAnswerNeedsOneLp) {
   FAIL() << "no random instance with a gamma and a signed b_j in seeds 1-40";
 }
 
+TEST(ExactBounds, AnEndpointShortOfItsTargetSpendsTheBudgetTheOthersLeave) {
+  // Inner hull [0, 1]: at ratio 1.25 each end may lie 0.125 outside it.
+  auto interval = [](double lo, double hi) {
+    ExactInterval iv;
+    iv.lower.value = lo;
+    iv.upper.value = hi;
+    iv.inner = std::make_pair(0.0, 1.0);
+    return iv;
+  };
+  EXPECT_FALSE(ShortOfTarget(interval(-0.1, 1.1), false, 1.25));
+  EXPECT_TRUE(ShortOfTarget(interval(-0.2, 1.1), false, 1.25));
+  EXPECT_TRUE(ShortOfTarget(interval(-0.1, 1.2), true, 1.25));
+  ExactInterval without_inner = interval(-0.1, 1.1);
+  without_inner.inner.reset();
+  EXPECT_TRUE(ShortOfTarget(without_inner, true, 1.25));
+
+  // 8 intervals = 16 endpoints.
+  std::vector<ExactInterval> ivs(8, interval(-0.1, 1.1));
+  EXPECT_TRUE(NoneShortOfTarget(ivs, 1.25));              // no further sweep needed
+  EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 4), 10);  // nobody short: the plain budget
+  ivs[3] = interval(-0.2, 1.1);                           // one short endpoint: 16x, capped at 4x
+  EXPECT_FALSE(NoneShortOfTarget(ivs, 1.25));
+  EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 4), 40);
+  EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 1), 10);   // cap 1: off
+  for (int k = 0; k < 5; ++k) ivs[k] = interval(-0.2, 1.1);  // 5 short: 16 / 5 = 3 times
+  EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 4), 30);
+  for (auto& iv : ivs) iv = interval(-0.5, 1.5);         // all short (the first sweep): the plain budget
+  EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 4), 10);
+}
+
 TEST(LpBackends, ClpAndGlpkAgreeOnTheOptimumAndBothDualsCertify) {
   const auto inst = InstanceOf(11, 80);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
