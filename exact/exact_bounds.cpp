@@ -267,16 +267,23 @@ std::string MonotoneAssumptionText() {
          "[min(y - dy), max(y + dy)] (paper 001 takes it invertible; alpha_1 = 1 fixes the sign)";
 }
 
+bool WithinTarget(const ExactInterval& interval, double target_ratio) {
+  if (!interval.inner) return false;
+  const auto [lo, hi] = *interval.inner;
+  return interval.upper.value - interval.lower.value <= target_ratio * (hi - lo);
+}
+
 bool ShortOfTarget(const ExactInterval& interval, bool maximise, double target_ratio) {
+  if (WithinTarget(interval, target_ratio)) return false;
   if (!interval.inner) return true;
   const auto [lo, hi] = *interval.inner;
   const double gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
   return maximise ? interval.upper.value > hi + gap : interval.lower.value < lo - gap;
 }
 
-bool NoneShortOfTarget(const std::vector<ExactInterval>& intervals, double target_ratio) {
+bool AllWithinTarget(const std::vector<ExactInterval>& intervals, double target_ratio) {
   for (const auto& iv : intervals)
-    if (ShortOfTarget(iv, false, target_ratio) || ShortOfTarget(iv, true, target_ratio)) return false;
+    if (!WithinTarget(iv, target_ratio)) return false;
   return true;
 }
 
@@ -453,8 +460,8 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
   // After the sweeps, a closing pass for the endpoints still short of their target (sweep options.sweeps + 1).
   const bool closing_pass = inner_ranges && options.short_endpoint_budget_cap > 1;
   for (int sweep = form_ranges.empty() ? 1 : 0; sweep <= options.sweeps + (closing_pass ? 1 : 0); ++sweep) {
-    // Every endpoint within its target: a further sweep would narrow what needs no narrowing.
-    if (sweep >= 2 && inner_ranges && NoneShortOfTarget(s.intervals, options.target_ratio)) break;
+    // Every interval within its target: a further sweep would narrow what needs no narrowing.
+    if (sweep >= 2 && inner_ranges && AllWithinTarget(s.intervals, options.target_ratio)) break;
     const bool closing = sweep > options.sweeps;
     const std::string phase = sweep == 0   ? std::string("bound (the dynamics forms)")
                               : closing    ? std::string("bound (closing pass, the endpoints short of their target)")

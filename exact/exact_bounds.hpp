@@ -45,7 +45,7 @@ struct ExactBoundsOptions {
   PruneStop prune;
   ObjectiveSearchOptions search;
   // Bounding sweeps at most; each after the first starts in the box the previous proved. Sweeps stop early once
-  // every endpoint is within target_ratio of the inner hull.
+  // every interval is within target_ratio times its inner hull.
   int sweeps = 4;
   // Bound and halve forms across D's thin directions in (a_1..a_na) too (exact/dynamics_forms.hpp).
   bool dynamics_forms = true;
@@ -122,9 +122,12 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
                                       const dss::HwData& data, const ParamBox& start_box,
                                       const std::function<void(const ExactBoundsProgress&)>& progress = {});
 
-// Whether an endpoint is farther from its inner hull than outer/inner <= target_ratio allows (no inner hull: yes).
+// Whether an interval's outer/inner width is at most target_ratio (no inner hull: no).
+bool WithinTarget(const ExactInterval& interval, double target_ratio);
+bool AllWithinTarget(const std::vector<ExactInterval>& intervals, double target_ratio);
+// Whether an endpoint of an interval beyond its target lies farther from its inner hull than (target_ratio - 1) / 2
+// of the inner width (no inner hull: yes) — the end that keeps the interval from its target.
 bool ShortOfTarget(const ExactInterval& interval, bool maximise, double target_ratio);
-bool NoneShortOfTarget(const std::vector<ExactInterval>& intervals, double target_ratio);
 // The LP budget of an endpoint still short of its target in the closing pass: what a sweep would have given every
 // endpoint, shared among the short ones — lp_budget times (endpoints / short ones), at most `cap` times — so the
 // pass never spends more than a sweep's budget.

@@ -123,18 +123,22 @@ TEST(ExactBounds, AnEndpointShortOfItsTargetSpendsTheBudgetTheOthersLeave) {
     return iv;
   };
   EXPECT_FALSE(ShortOfTarget(interval(-0.1, 1.1), false, 1.25));
-  EXPECT_TRUE(ShortOfTarget(interval(-0.2, 1.1), false, 1.25));
+  EXPECT_TRUE(ShortOfTarget(interval(-0.2, 1.1), false, 1.25));   // ratio 1.3: the lower end keeps it there
+  EXPECT_FALSE(ShortOfTarget(interval(-0.2, 1.1), true, 1.25));
   EXPECT_TRUE(ShortOfTarget(interval(-0.1, 1.2), true, 1.25));
+  EXPECT_TRUE(WithinTarget(interval(-0.2, 1.0), 1.25));            // ratio 1.2: no end is short
+  EXPECT_FALSE(ShortOfTarget(interval(-0.2, 1.0), false, 1.25));
   ExactInterval without_inner = interval(-0.1, 1.1);
   without_inner.inner.reset();
+  EXPECT_FALSE(WithinTarget(without_inner, 1.25));
   EXPECT_TRUE(ShortOfTarget(without_inner, true, 1.25));
 
   // 8 intervals = 16 endpoints.
   std::vector<ExactInterval> ivs(8, interval(-0.1, 1.1));
-  EXPECT_TRUE(NoneShortOfTarget(ivs, 1.25));              // no further sweep needed
+  EXPECT_TRUE(AllWithinTarget(ivs, 1.25));                // no further sweep needed
   EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 4), 10);  // nobody short: the plain budget
   ivs[3] = interval(-0.2, 1.1);                           // one short endpoint: 16x, capped at 4x
-  EXPECT_FALSE(NoneShortOfTarget(ivs, 1.25));
+  EXPECT_FALSE(AllWithinTarget(ivs, 1.25));
   EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 4), 40);
   EXPECT_EQ(ShortEndpointBudget(ivs, 1.25, 10, 1), 10);   // cap 1: off
   for (int k = 0; k < 5; ++k) ivs[k] = interval(-0.2, 1.1);  // 5 short: 16 / 5 = 3 times
