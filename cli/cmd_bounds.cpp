@@ -97,6 +97,7 @@ struct BoundsCliOptions {
   std::string set = "dss";  // which feasible set the intervals bound: dss (D^ss(n)) or exact (D, after D^ss(n))
   int lp_budget = exact::ObjectiveSearchOptions{}.lp_budget;
   int sweeps = exact::ExactBoundsOptions{}.sweeps;
+  double target_ratio = exact::ExactBoundsOptions{}.target_ratio;
   std::string lp_solver = exact::ExactBoundsOptions{}.lp_solver;
 };
 
@@ -105,12 +106,15 @@ exact::ExactBoundsOptions MakeExactOptions(const BoundsCliOptions& o, const dss:
   if (o.lp_budget < 1)
     throw InputError(fmt::format("--lp-budget {}: LPs per endpoint refinement must be at least 1", o.lp_budget));
   if (o.sweeps < 1 || o.sweeps > 5) throw InputError(fmt::format("--sweeps {}: expected 1..5", o.sweeps));
+  if (!(o.target_ratio >= 1.0))
+    throw InputError(fmt::format("--target-ratio {}: expected a ratio of widths >= 1, e.g. 1.25", o.target_ratio));
   exact::ExactBoundsOptions options;
   options.executor = dss.executor;
   options.run_dir = o.run_dir;
   options.parameters = o.params;
   options.search.lp_budget = o.lp_budget;
   options.sweeps = o.sweeps;
+  options.target_ratio = o.target_ratio;
   options.lp_solver = o.lp_solver;
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
@@ -311,7 +315,10 @@ void AddBoundsCommand(CLI::App& app) {
       ->check(CLI::IsMember({"dss", "exact"}));
   cmd->add_option("--lp-budget", o->lp_budget, "--set exact: LPs per endpoint refinement (>= 1)");
   cmd->add_option("--sweeps", o->sweeps, "--set exact: bounding sweeps at most, each in the box the previous proved; they stop once every "
-                  "interval is within 1.25 times its inner hull (1..5)");
+                  "interval is within --target-ratio times its inner hull (1..5)");
+  cmd->add_option("--target-ratio", o->target_ratio,
+                  "--set exact: an endpoint's refinement stops once its interval would be at most this many times as wide "
+                  "as the inner hull (>= 1; 1.25 by default; smaller costs more LPs)");
   cmd->add_option("--lp-solver", o->lp_solver, "--set exact: the LP backend, clp, glpk, ipm or ipm-only (certificates do not depend on it)")
       ->check(CLI::IsMember(exact::AvailableLpSolvers()));
   cmd->add_option("--json", o->json_out, "write the result as JSON");

@@ -195,6 +195,9 @@ int main(int argc, char** argv) {
   app.add_option("--lp-budget", lp_budget, "LPs per endpoint refinement");
   app.add_option("--sweeps", sweeps, "bounding sweeps")->check(CLI::PositiveNumber);
   int short_cap = exact::ExactBoundsOptions{}.short_endpoint_budget_cap;
+  double target_ratio = exact::ExactBoundsOptions{}.target_ratio;
+  app.add_option("--target-ratio", target_ratio, "an endpoint's refinement stops once outer/inner would be at most this")
+      ->check(CLI::Range(1.0, 100.0));
   app.add_option("--short-budget-cap", short_cap,
                  "after the sweeps, an endpoint short of the target gets up to this many times --lp-budget (1 = off)")
       ->check(CLI::PositiveNumber);
@@ -253,6 +256,7 @@ int main(int argc, char** argv) {
     options.run_dir = run_dir;
     options.sweeps = sweeps;
     options.short_endpoint_budget_cap = short_cap;
+    options.target_ratio = target_ratio;
     options.lp_solver = lp_solver;
     options.parameters = parameters;
     const auto s = exact::ComputeExactBounds(options, dss::CeroneExampleStructure(), data, one.box,
@@ -265,11 +269,11 @@ int main(int argc, char** argv) {
         "# Exact set D, seed {}, N = {}, {} dB (realised {:.2f} dB), noise bound {:.6g}\n\n"
         "Start box: D^ss(2) at δ = {} from `{}` (stage 1: {:.0f} s wall in that committed run, which may have read "
         "its jobs from a run cache){}. Command: `exact_tables --tables {} --out {} --threads {} --lp-budget {} "
-        "--sweeps {} --short-budget-cap {} --lp-solver {} --split {} --gamma-ratio {}{}`.\n\n",
+        "--sweeps {} --short-budget-cap {} --target-ratio {} --lp-solver {} --split {} --gamma-ratio {}{}`.\n\n",
         one.seed, one.samples, one.snr_db, ex.snr_db, ex.noise_bound, one.order, tables, one.seconds,
         box_proven ? "" : fmt::format("; that run's record is not this one, so here the box is an assumed prior box "
                                       "(the intervals bound D inside it), not a proven one"),
-        tables, out, threads, lp_budget, sweeps, short_cap, lp_solver, split, gamma_ratio,
+        tables, out, threads, lp_budget, sweeps, short_cap, target_ratio, lp_solver, split, gamma_ratio,
         (samples > 0 ? fmt::format(" --samples {}", samples) : std::string()) +
             (seed > 0 ? fmt::format(" --seed {}", seed) : std::string()));
     md += Table(s, one, truth);

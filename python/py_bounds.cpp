@@ -203,13 +203,14 @@ void DefineBounds(py::module_& m) {
          bool edge_witnesses, bool moment_witnesses, bool lp_screen, bool retry_with_other_solver, bool full_pass_contraction,
          int contraction_passes, double contraction_min_shrink, int contraction_max_rounds,
          int row_block_order, int stopped_short_refinements, int endpoint_refinements, int max_rounds, int add_per_round, double violation_tolerance, bool verify,
-         py::object progress, std::string source, bool report, std::string set, int lp_budget, int sweeps, std::string lp_solver) {
+         py::object progress, std::string source, bool report, std::string set, int lp_budget, int sweeps, double target_ratio, std::string lp_solver) {
         BoundsArgs a;
         if (set != "dss" && set != "exact")
           throw py::value_error(fmt::format("set '{}' unknown; expected 'dss' or 'exact'", set));
         a.set = set;
         a.exact.search.lp_budget = lp_budget;
         a.exact.sweeps = sweeps;
+        a.exact.target_ratio = target_ratio;
         a.exact.lp_solver = lp_solver;
         if (std::string error; !a.exact.IsValid(&error)) throw py::value_error(error);
         a.structure.na = na;
@@ -263,7 +264,7 @@ Returns the CLI's JSON as a dict: intervals (lower/upper value, status, verifica
 counts, timing, ... The GIL is released while the engine runs; Ctrl-C stops the run (KeyboardInterrupt) and
 its worker processes; with run_dir a rerun resumes from the finished jobs.
 set: "dss" (the default: D^ss(n)) or "exact": the exact set D bounded inside the D^ss(n) box (CLI --set exact;
-docs/exact_set.md); lp_budget, sweeps and lp_solver are the CLI's --lp-budget, --sweeps and --lp-solver. With "exact" the dict has
+docs/exact_set.md); lp_budget, sweeps, target_ratio and lp_solver are the CLI's --lp-budget, --sweeps, --target-ratio and --lp-solver. With "exact" the dict has
 "set": "exact", intervals of D (with the inner hull), "outer_set_intervals", "stage2" counts and "assumption".
 report: also return the text `hwbounds bounds` prints, as "brief_report" (the interval table and warnings, or the
 verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the bounds came from).)doc",
@@ -287,6 +288,7 @@ verdict) and "full_report" (all of it: pieces, rounds, counts, times, where the 
       py::arg("verify") = g.verify.enabled, py::arg("progress") = py::none(), py::arg("source") = "data",
       py::arg("report") = false, py::arg("set") = "dss",
       py::arg("lp_budget") = exact::ObjectiveSearchOptions{}.lp_budget, py::arg("sweeps") = exact::ExactBoundsOptions{}.sweeps,
+      py::arg("target_ratio") = exact::ExactBoundsOptions{}.target_ratio,
       py::arg("lp_solver") = exact::ExactBoundsOptions{}.lp_solver);
 }
 

@@ -35,3 +35,9 @@ def test_unknown_lp_solver_is_a_value_error_before_any_work(recording):
     _, rec = recording
     with pytest.raises(ValueError, match="LP solver 'highs' unknown; expected one of: clp, glpk"):
         hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, set="exact", lp_solver="highs")
+
+
+def test_target_ratio_below_one_is_a_value_error_before_any_work(recording):
+    _, rec = recording
+    with pytest.raises(ValueError, match="target_ratio must be >= 1"):
+        hwbounds.bounds(rec["u"], rec["y"], rec["noise_bound"], horizon=1, set="exact", target_ratio=0.9)
