@@ -199,6 +199,46 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
   }
 }
 
+// A relay's threshold is seen only through which input moves cross it: on an input of few levels (steps,
+// PRBS) every threshold between two levels reached gives the same prediction, and the identification
+// recording cannot tell where in that run the device switches. Validation, with other levels, can: a
+// threshold the fit placed in the middle of the run may switch on moves the device ignores there. When
+// the held-out tail confirms a relay and validation does not, every threshold that predicts the whole
+// identification recording exactly as the fitted one (the model otherwise unchanged) is an equally
+// supported model, and validation judges the best of them. The choice is among models the data used
+// for fitting cannot tell apart; the block must still pass every test.
+void ChooseRelayThresholdAmongTies(const Context& c, const Reference& ref, Finding* f) {
+  if (f->model.blocks.size() != 1 || f->model.blocks[0].effect != Effect::kHysteresis) return;
+  std::vector<double> mags;
+  for (const Vec* u : {&c.ident.u, &c.valid.u})
+    for (double v : *u) mags.push_back(std::abs(v));
+  std::sort(mags.begin(), mags.end());
+  mags.erase(std::unique(mags.begin(), mags.end()), mags.end());
+  std::vector<double> values;
+  const std::size_t stride = std::max<std::size_t>(1, mags.size() / 400);
+  for (std::size_t k = 0; k + 1 < mags.size(); k += stride) values.push_back(0.5 * (mags[k] + mags[k + 1]));
+  const Vec pred = f->model.simulate(c.ident.u);
+  const double sse0 = SumSquaredError(f->model, c.full);
+  AugmentedModel best = f->model;
+  double best_mse = Mse(c.ValidationResidual(f->model), c.skip, c.nv);
+  for (double beta : values) {
+    AugmentedModel t = f->model;
+    t.blocks[0].params[0] = beta;
+    std::string err;
+    if (!t.blocks[0].IsValid(&err)) continue;
+    const Vec p = t.simulate(c.ident.u);
+    double diff = 0.0;
+    for (std::size_t i = c.skip; i < p.size(); ++i) diff = std::max(diff, std::abs(p[i] - pred[i]));
+    if (!(diff <= 1e-9 * (1.0 + std::sqrt(sse0 / std::max<double>(c.n - c.skip, 1))))) continue;
+    const double mse = Mse(c.ValidationResidual(t), c.skip, c.nv);
+    if (mse < best_mse) best_mse = mse, best = t;
+  }
+  if (best.blocks[0].params[0] == f->model.blocks[0].params[0]) return;
+  f->model = best;
+  f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(best), c.skip, c.nv, f->extra_parameters,
+                            c.o.validation_z);
+}
+
 // The model's nominal part alone, its parameters as fitted with the blocks.
 AugmentedModel WithoutBlocks(AugmentedModel m) {
   m.blocks.clear();
@@ -251,6 +291,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
                            c.o.validation_z);
   if (f.holdout.significant != f.validation.significant) ReconcileFits(c, ref, effect, location, chosen, &f);
+  if (f.holdout.significant && !f.validation.significant) ChooseRelayThresholdAmongTies(c, ref, &f);
   bool meaningful = true;
   for (const auto& b : f.blocks)
     if (b.location != Location::kState)

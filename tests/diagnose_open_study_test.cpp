@@ -201,6 +201,25 @@ TEST(NominalStatus, ABlockThatOnlyFreesAStuckNominalIsAFailedFitNotAnEffect) {
   EXPECT_NE(r.nominal_status_note.find("poor optimum"), std::string::npos) << r.nominal_status_note;
 }
 
+// A relay on random steps: every threshold between two input levels predicts the identification
+// recording alike, and the middle of that run (the fit's choice) switched on validation levels the
+// device ignores (validation MSE 1.4-1.8x the baseline's, verdict none). Validation now judges the best
+// threshold among those the identification recording cannot tell apart (retired seeds 700 080, 700 457).
+TEST(OpenStudy, RelayThresholdUndeterminedByStepsIsJudgedAmongItsTies) {
+  for (unsigned seed : {700080u, 700457u}) {
+    OpenScenarioOptions so;
+    so.effect = Effect::kHysteresis;
+    so.seed = seed;
+    const OpenScenario sc = MakeOpenScenario(so);
+    DiagnoseOptions o;
+    o.threads = 1;
+    DiagnoseReport r;
+    Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &r);
+    ASSERT_TRUE(r.ok) << r.message;
+    EXPECT_EQ(r.verdict, Effect::kHysteresis) << "seed " << seed << ": " << r.message;
+  }
+}
+
 // Named right on development seeds where the verdict used to be `none`: a delay that a richer numerator
 // also absorbs (seed 1023: the delay, one parameter, competes with the richer nominal's two), and a
 // backlash whose held-out tail shows nothing of it that the roles-swapped test (switched on here)
