@@ -904,7 +904,12 @@ bool BlocksNeeded(const Context& c, const Finding& f, double* bare_holdout_rmse)
   const Comparison held = c.Compare(e_bare, c.IdentResidual(f.fitted), c.nfit, c.n, 0, c.o.significance_z);
   const Comparison valid = c.Compare(c.ValidationResidual(bare_model), c.ValidationResidual(f.model), c.skip, c.nv, 0,
                                      c.o.validation_z);
-  return held.significant || valid.significant;
+  // A limit reached only in the fitting part (a state saturation hit a few times early in a closed-loop
+  // recording) holds the nominal part at its values there, and the tail and validation, where it is not
+  // reached, then show the nominal part alone at the noise: the blocks make the difference on the data
+  // they were fitted on (the same test as on validation).
+  const Comparison fitted = c.Compare(e_bare, c.IdentResidual(f.fitted), c.skip, c.nfit, 0, c.o.validation_z);
+  return held.significant || valid.significant || fitted.significant;
 }
 
 // Did the baseline reach the noise floor on the held-out tail? When it did not, a verdict is kept only

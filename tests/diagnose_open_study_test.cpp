@@ -245,6 +245,26 @@ TEST(OpenStudy, DelayTiedWithARicherNominalAndDelayFromFreshStarts) {
   }
 }
 
+// A state saturation reached only in the fitting part of a closed-loop recording (retired seed 700 190,
+// lower limit only): with it the nominal part is held at its true values, and without it that nominal
+// part alone is at the noise on the held-out tail and on validation, where the limit is not reached, so
+// the blocks seemed to make no difference and the fit was called failed (a poor optimum freed). On the
+// fitting part they do: removing them there is significantly worse.
+TEST(NominalStatus, ALimitReachedOnlyInTheFittingPartIsNeededThere) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kStateSaturation;
+  so.location = Location::kState;
+  so.seed = 700190;
+  const OpenScenario sc = MakeOpenScenario(so);
+  DiagnoseOptions o;
+  o.threads = 1;
+  DiagnoseReport r;
+  Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &r);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.verdict, Effect::kStateSaturation) << r.message;
+  EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
+}
+
 // Named right on development seeds where the verdict used to be `none`: a delay that a richer numerator
 // also absorbs (seed 1023: the delay, one parameter, competes with the richer nominal's two), and a
 // backlash whose held-out tail shows nothing of it that the roles-swapped test (switched on here)
