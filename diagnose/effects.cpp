@@ -368,15 +368,20 @@ std::vector<double> ApplyInputBlock(const EffectBlock& block, const std::vector<
     case Effect::kStiction: {
       // He, Wang, Pottmann, Qin (2007): stuck until the input has moved more than the static band from
       // the stem; then the stem follows at the kinetic lag until the input reverses or stops.
+      // A moving stem sits exactly fd behind the input, so when the input holds still |u_t - x_{t-1}|
+      // equals fd up to the rounding of u - (u - fd), which falls on either side of fd (about 4 holds
+      // in 10). A difference must therefore exceed a band by kStictionBandTolerance relative to the
+      // signal's magnitude to count: a hold always stops the stem, whatever the last bits.
       const double fs = block.params[0], fd = block.params[1];
       double prev = u[0], dir = 0.0;
       bool stuck = true;
       for (std::size_t t = 0; t < n; ++t) {
         const double d = u[t] - prev;
-        if (stuck && std::abs(d) > fs) {
+        const double tol = kStictionBandTolerance * (std::abs(u[t]) + std::abs(prev) + fs);
+        if (stuck && std::abs(d) > fs + tol) {
           stuck = false;
           dir = Sign(d);
-        } else if (!stuck && !(Sign(d) == dir && std::abs(d) > fd)) {
+        } else if (!stuck && !(Sign(d) == dir && std::abs(d) > fd + tol)) {
           stuck = true;
         }
         prev = x[t] = stuck ? prev : u[t] - dir * fd;

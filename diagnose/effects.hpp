@@ -124,6 +124,10 @@ std::string ParameterText(const EffectBlock& block, const AugmentedModel& model)
 // input moves the velocity by sum(b) per unit per step (identity input map). Empty for other blocks.
 std::vector<double> FrictionLevelsInInputUnits(const EffectBlock& block, const AugmentedModel& model);
 
+// Stiction's bands are compared with |u_t - x_{t-1}| up to this tolerance relative to |u_t| + |x_{t-1}| +
+// static band: a difference within it of a band is not beyond the band (a moving stem sits exactly the
+// kinetic band behind the input, so a hold must stop it independently of rounding).
+inline constexpr double kStictionBandTolerance = 1e-9;
 // Applies a memoryful or static input-location block to a signal (exposed for tests and the generator).
 std::vector<double> ApplyInputBlock(const EffectBlock& block, const std::vector<double>& u);
 // Deadzone, saturation, quantization; `smoothing` > 0 rounds a quantizer smoothly (width in steps).

@@ -219,7 +219,8 @@ EffectBlock SizeEffect(const EffectShape& shape, const HwModel& lin, const Vec& 
 }
 
 // RMS of the part of the true output that the nominal structure (the true system without the effect,
-// refitted: linear block, maps, offset, initial state) cannot reproduce on input u.
+// refitted: linear block, maps, offset, initial state) cannot reproduce on input u (for stiction, nor
+// backlash).
 double VisibleRms(const AugmentedModel& truth, const Vec& u) {
   const Vec y = truth.simulate(u);
   const Segment s{&u, &y, 0, 0};
@@ -229,7 +230,19 @@ double VisibleRms(const AugmentedModel& truth, const Vec& u) {
   richer.nominal.linear.a.push_back(0.0);
   richer.nominal.linear.b.push_back(0.0);
   richer = RefitModel(richer, s, RefitOptions{}).model;
-  return std::sqrt(std::min(SumSquaredError(nominal, s), SumSquaredError(richer, s)) / y.size());
+  double sse = std::min(SumSquaredError(nominal, s), SumSquaredError(richer, s));
+  // Stiction with equal bands is backlash: when every input move is larger than the static band the two
+  // give the same signal (the stem never stays stuck where backlash would follow), and what a stiction
+  // scenario must show is its stick-slip jump, the part backlash (fitted from the grid and from the
+  // kinetic band) cannot absorb.
+  if (truth.blocks.size() == 1 && truth.blocks[0].effect == Effect::kStiction) {
+    const EffectBlock& b = truth.blocks[0];
+    sse = std::min(sse, AddBlock(truth.WithoutBlocks(), Effect::kBacklash, b.location, b.state_variable, s, RefitOptions{}).sse);
+    AugmentedModel play = truth;
+    play.blocks[0] = {Effect::kBacklash, b.location, {b.params[1]}, b.state_variable};
+    sse = std::min(sse, RefitModel(play, s, RefitOptions{}).sse);
+  }
+  return std::sqrt(sse / y.size());
 }
 
 StaticMap RandomMonotoneCubic(Rng& rng, double scale) {

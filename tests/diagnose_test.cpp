@@ -64,6 +64,22 @@ TEST(EffectBlocks, StictionSticksThenSlips) {
   for (std::size_t i = 0; i < s.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-12) << i;
 }
 
+TEST(EffectBlocks, StictionStopsOnEveryHoldWhateverTheRounding) {
+  // A moving stem sits the kinetic band behind the input; when the input then holds still the stem must
+  // stop, so a further small move in the same direction (smaller than the static band) leaves it stuck.
+  // Without a tolerance, |u - (u - fd)| > fd held for about 4 in 10 of these (level, band) pairs.
+  int moved_on = 0, cases = 0;
+  for (int i = 1; i < 200; ++i)
+    for (int j = 1; j < 20; ++j) {
+      const double a = 0.8 + 0.073 * i, fd = 0.013 * j, fs = 3 * fd;  // a > fs: it breaks away
+      const auto x = ApplyInputBlock({Effect::kStiction, Location::kInput, {fs, fd}}, {0.0, a, a, a + fd});
+      ++cases;
+      EXPECT_EQ(x[1], a - fd);  // broke away, kinetic band behind
+      if (x[3] != x[2]) ++moved_on;
+    }
+  EXPECT_EQ(moved_on, 0) << "of " << cases;
+}
+
 TEST(EffectBlocks, CoulombFrictionHoldsAVelocityStateAtRest) {
   // Force -> velocity drive v_t = 0.9 v_{t-1} + 0.1 F_{t-1}; friction levels 0.05 (up) and 0.02 (down).
   AugmentedModel m;
