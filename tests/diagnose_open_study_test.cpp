@@ -181,6 +181,22 @@ TEST(StictionFit, FindsTheStickSlipJumpThatBacklashCannotDescribe) {
   EXPECT_LT(stiction.sse, 0.95 * backlash.sse);
 }
 
+// An open-study scenario diagnosed with its true nominal given, or with its structure fitted by the tool.
+struct OpenDiagnosis {
+  OpenScenario scenario;
+  DiagnoseReport report;
+};
+OpenDiagnosis DiagnoseOpenScenario(const OpenScenarioOptions& so, bool fitted, DiagnoseOptions o = {}) {
+  OpenDiagnosis d{MakeOpenScenario(so), {}};
+  const OpenScenario& sc = d.scenario;
+  o.threads = 1;
+  if (fitted)
+    Diagnose(o, FitNominalForDiagnosis(sc.structure, sc.ident, o).model, &sc.structure, sc.ident, sc.valid, &d.report);
+  else
+    Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &d.report);
+  return d;
+}
+
 // A null recording whose fitted nominal stays stuck in a poor optimum (held-out RMSE 2.2x the noise): the
 // refit of an input quantizer of a small step freed the nominal part under it, which alone (the block
 // removed) reaches the noise, and was named as an effect. The blocks must make the difference, otherwise
@@ -189,11 +205,7 @@ TEST(NominalStatus, ABlockThatOnlyFreesAStuckNominalIsAFailedFitNotAnEffect) {
   OpenScenarioOptions so;
   so.effect = Effect::kNone;
   so.seed = 500252;
-  const OpenScenario sc = MakeOpenScenario(so);
-  DiagnoseOptions o;
-  o.threads = 1;
-  DiagnoseReport r;
-  Diagnose(o, FitNominalForDiagnosis(sc.structure, sc.ident, o).model, &sc.structure, sc.ident, sc.valid, &r);
+  const auto [sc, r] = DiagnoseOpenScenario(so, /*fitted=*/true);
   ASSERT_TRUE(r.ok) << r.message;
   EXPECT_GT(r.baseline_holdout_rmse, 1.2 * sc.noise_std);
   EXPECT_EQ(r.verdict, Effect::kNone) << r.message;
@@ -210,11 +222,7 @@ TEST(OpenStudy, RelayThresholdUndeterminedByStepsIsJudgedAmongItsTies) {
     OpenScenarioOptions so;
     so.effect = Effect::kHysteresis;
     so.seed = seed;
-    const OpenScenario sc = MakeOpenScenario(so);
-    DiagnoseOptions o;
-    o.threads = 1;
-    DiagnoseReport r;
-    Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &r);
+    const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
     ASSERT_TRUE(r.ok) << r.message;
     EXPECT_EQ(r.verdict, Effect::kHysteresis) << "seed " << seed << ": " << r.message;
   }
@@ -232,14 +240,7 @@ TEST(OpenStudy, DelayTiedWithARicherNominalAndDelayFromFreshStarts) {
     OpenScenarioOptions so;
     so.effect = Effect::kDelay;
     so.seed = seed;
-    const OpenScenario sc = MakeOpenScenario(so);
-    DiagnoseOptions o;
-    o.threads = 1;
-    DiagnoseReport r;
-    if (fitted)
-      Diagnose(o, FitNominalForDiagnosis(sc.structure, sc.ident, o).model, &sc.structure, sc.ident, sc.valid, &r);
-    else
-      Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &r);
+    const DiagnoseReport r = DiagnoseOpenScenario(so, fitted).report;
     ASSERT_TRUE(r.ok) << r.message;
     EXPECT_EQ(r.verdict, Effect::kDelay) << "seed " << seed << ": " << r.message;
   }
@@ -255,11 +256,7 @@ TEST(NominalStatus, ALimitReachedOnlyInTheFittingPartIsNeededThere) {
   so.effect = Effect::kStateSaturation;
   so.location = Location::kState;
   so.seed = 700190;
-  const OpenScenario sc = MakeOpenScenario(so);
-  DiagnoseOptions o;
-  o.threads = 1;
-  DiagnoseReport r;
-  Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &r);
+  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
   ASSERT_TRUE(r.ok) << r.message;
   EXPECT_EQ(r.verdict, Effect::kStateSaturation) << r.message;
   EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
@@ -274,12 +271,9 @@ TEST(OpenStudy, DelayAgainstARicherNumeratorAndEffectsOutsideTheHeldOutTail) {
     OpenScenarioOptions so;
     so.effect = effect;
     so.seed = seed;
-    const OpenScenario sc = MakeOpenScenario(so);
     DiagnoseOptions o;
-    o.threads = 1;
     o.swapped_min_improvement = 0.3;
-    DiagnoseReport r;
-    Diagnose(o, sc.nominal, nullptr, sc.ident, sc.valid, &r);
+    const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false, o).report;
     ASSERT_TRUE(r.ok) << r.message;
     EXPECT_EQ(r.verdict, effect) << "seed " << seed << ": " << r.message;
   }
