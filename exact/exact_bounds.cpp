@@ -163,6 +163,9 @@ bool GammaWithoutDenominator(const LiftedData& data, const ParamBox& box, int k)
   return true;
 }
 
+// How far each end may lie outside the inner hull [lo, hi] for outer/inner <= target_ratio.
+double EndAllowance(double lo, double hi, double target_ratio) { return 0.5 * (target_ratio - 1.0) * (hi - lo); }
+
 // Stage 3, one sweep: every wanted endpoint (and, for the box of the next sweep, every parameter and form)
 // refined. The forms' new ranges go to `form_ranges`. With `closing_budget`: only the endpoints still short of
 // their target, each with that budget.
@@ -190,8 +193,7 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
       if (inner && (*inner)[k]) {
         const auto [lo, hi] = *(*inner)[k];
         target = maximise ? hi : lo;
-        // Each end may be this far outside the inner hull for outer/inner <= target_ratio.
-        gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
+        gap = EndAllowance(lo, hi, target_ratio);
       }
       objectives.push_back({k, maximise});
       std::optional<int> budget;
@@ -277,7 +279,7 @@ bool ShortOfTarget(const ExactInterval& interval, bool maximise, double target_r
   if (WithinTarget(interval, target_ratio)) return false;
   if (!interval.inner) return true;
   const auto [lo, hi] = *interval.inner;
-  const double gap = 0.5 * (target_ratio - 1.0) * (hi - lo);
+  const double gap = EndAllowance(lo, hi, target_ratio);
   return maximise ? interval.upper.value > hi + gap : interval.lower.value < lo - gap;
 }
 
