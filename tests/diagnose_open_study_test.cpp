@@ -279,5 +279,22 @@ TEST(OpenStudy, DelayAgainstARicherNumeratorAndEffectsOutsideTheHeldOutTail) {
   }
 }
 
+// Input saturations the fit could not describe (retired seeds 800 111 and 800 417, nominal given): on a
+// PRBS input no finite limit was tried (every quantile is one of the two levels), and hysteresis with a
+// threshold never crossed (a constant input offset) was named; on steps whose fitting part reaches
+// neither limit while the held-out tail does, the limits stood where the optimiser stopped, and the
+// held-out tail showed nothing. A limit the fitting part does not reach now sits at its extreme.
+TEST(OpenStudy, InputSaturationOnFewLevelsAndBeyondTheFittingPart) {
+  for (unsigned seed : {800111u, 800417u}) {
+    OpenScenarioOptions so;
+    so.effect = Effect::kSaturation;
+    so.seed = seed;
+    const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
+    ASSERT_TRUE(r.ok) << r.message;
+    EXPECT_EQ(r.verdict, Effect::kSaturation) << "seed " << seed << ": " << r.message;
+    EXPECT_EQ(r.verdict_location, Location::kInput) << "seed " << seed << ": " << r.message;
+  }
+}
+
 }  // namespace
 }  // namespace hw::diagnose
