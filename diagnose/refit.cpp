@@ -254,19 +254,21 @@ Vec LimitCandidates(const Vec& v, bool upper) {
     if (std::abs(next - level) > 0.01 * range) out.push_back(0.5 * (level + next));
   }
   const double lowest = Quantile(v, 0.0), highest = Quantile(v, 1.0);
-  // On an input of few levels (PRBS: two) every quantile above is the extreme level itself, which
-  // clamps nothing, and no limit would be tried at all: a limit that moves the extreme level inwards
-  // (the one kind of saturation such an input can show) starts between the extreme and the next level
-  // inwards, where the cost is smooth in the limit.
-  const auto inward = upper ? std::lower_bound(sorted.begin(), sorted.end(), highest - 0.01 * range)
-                            : std::upper_bound(sorted.begin(), sorted.end(), lowest + 0.01 * range);
-  if (upper ? inward != sorted.begin() : inward != sorted.end()) {
-    const double extreme = upper ? highest : lowest, next = upper ? *(inward - 1) : *inward;
-    for (double f : {0.5, 0.9}) out.push_back(next + f * (extreme - next));
-  }
   out.erase(std::remove_if(out.begin(), out.end(),
                            [&](double x) { return std::isfinite(x) && (upper ? x >= highest : x <= lowest); }),
             out.end());
+  // On an input of few levels (PRBS: two) every quantile above is the extreme level itself, which
+  // clamps nothing, and no limit would be tried at all: a limit that moves the extreme level inwards
+  // (the one kind of saturation such an input can show) then starts between the extreme and the next
+  // level inwards, where the cost is smooth in the limit.
+  if (std::none_of(out.begin(), out.end(), [](double x) { return std::isfinite(x); })) {
+    const auto inward = upper ? std::lower_bound(sorted.begin(), sorted.end(), highest - 0.01 * range)
+                              : std::upper_bound(sorted.begin(), sorted.end(), lowest + 0.01 * range);
+    if (upper ? inward != sorted.begin() : inward != sorted.end()) {
+      const double extreme = upper ? highest : lowest, next = upper ? *(inward - 1) : *inward;
+      for (double f : {0.5, 0.9}) out.push_back(next + f * (extreme - next));
+    }
+  }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -577,47 +579,6 @@ void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOption
   if (any) Lm(m, Packing::For(*m, o), s, o.lm);
 }
 
-// A saturation limit that no sample of the segment reaches changes nothing there: every value beyond
-// the segment's extreme ties with it, and LM and the tie search leave it wherever they stopped (an
-// arbitrary distance out), so that data beyond the segment (the held-out tail, validation) would judge
-// an arbitrary number. Such a limit is set to the tightest value the segment supports, the extreme of
-// the signal it acts on there (the cost on the segment does not change): a fit that has not seen a
-// limit reached predicts that the signal is limited beyond what it has seen, rather than at a value it
-// made up.
-void TightenUnreachedLimits(AugmentedModel* m, const Segment& s) {
-  for (std::size_t b = 0; b < m->blocks.size(); ++b) {
-    const Effect e = m->blocks[b].effect;
-    if (e != Effect::kSaturation && e != Effect::kStateSaturation) continue;
-    const Location l = m->blocks[b].location;
-    if (l == Location::kOutput)
-      for (std::size_t k = b + 1; k < m->blocks.size(); ++k)
-        if (m->blocks[k].location == Location::kOutput) return;
-    for (int side = 0; side < 2; ++side) {
-      const double limit = m->blocks[b].params[side];
-      if (!std::isfinite(limit)) continue;
-      AugmentedModel t = *m;
-      t.blocks[b].params[side] = side == 0 ? -HUGE_VAL : HUGE_VAL;
-      Vec v;
-      if (l == Location::kInput) {
-        v = *s.u;
-        for (std::size_t k = 0; k < b; ++k)
-          if (t.blocks[k].location == Location::kInput) v = ApplyInputBlock(t.blocks[k], v);
-      } else if (l == Location::kOutput) {
-        t.blocks.erase(t.blocks.begin() + static_cast<long>(b));
-        v = t.simulate(*s.u);
-      } else {
-        v = InnerState(t, *s.u);
-      }
-      if (v.size() < s.End() || s.Count() == 0) continue;
-      const auto [lo, hi] = std::minmax_element(v.begin() + static_cast<long>(s.skip), v.begin() + static_cast<long>(s.End()));
-      if (!std::isfinite(*lo) || !std::isfinite(*hi)) continue;
-      const double other = m->blocks[b].params[1 - side];
-      if (side == 1 && limit > *hi && *hi > other) m->blocks[b].params[side] = *hi;
-      if (side == 0 && limit < *lo && *lo < other) m->blocks[b].params[side] = *lo;
-    }
-  }
-}
-
 RefitResult Finish(const AugmentedModel& m, const Segment& s) {
   RefitResult r;
   r.model = m;
@@ -803,7 +764,6 @@ RefitResult RefitModel(const AugmentedModel& model, const Segment& s, const Refi
   if (SolveNumerator(&solved, s, o) && SumSquaredError(solved, s) < SumSquaredError(m, s)) m = solved;
   Lm(&m, Packing::For(m, o), s, o.lm);
   SearchOnlyParameters(&m, s, o);
-  TightenUnreachedLimits(&m, s);
   return Finish(m, s);
 }
 
@@ -892,8 +852,7 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);
     SearchOnlyParameters(&m, s, o);
-    TightenUnreachedLimits(&m, s);
-    RefitResult r = Finish(m, s);
+      RefitResult r = Finish(m, s);
     if (r.sse < best.sse) best = r;
   }
   if (!std::isfinite(best.sse)) best = RefitModel(base, s, o);  // no admissible grid point

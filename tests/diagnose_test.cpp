@@ -313,34 +313,6 @@ TEST(Refit, ASaturationOfATwoLevelInputIsFound) {
   EXPECT_LT(r.sse, 2.0 * u.size() * 0.01 * 0.01);
 }
 
-// A limit that no sample of the fitting segment reaches leaves the cost there unchanged anywhere beyond
-// the segment's extreme; the fit sets it to that extreme (the tightest limit the segment supports)
-// instead of wherever the optimiser stopped, so that data beyond the segment judge a defined number.
-TEST(Refit, ALimitTheSegmentNeverReachesSitsAtTheSegmentsExtreme) {
-  std::mt19937_64 rng(32);
-  std::uniform_real_distribution<double> small(-1.0, 1.0), large(-1.6, 1.6);
-  Vec u;
-  for (int t = 0; t < 600; ++t) u.push_back(small(rng));
-  for (int t = 0; t < 300; ++t) u.push_back(large(rng));
-  AugmentedModel truth;
-  truth.nominal.linear = {{-0.6}, {0.4}, 0};
-  truth.blocks.push_back({Effect::kSaturation, Location::kInput, {-HUGE_VAL, 1.3}, StateVariable::kPosition});
-  Vec y = truth.simulate(u);
-  std::normal_distribution<double> g(0.0, 0.01);
-  for (auto& v : y) v += g(rng);
-  const Segment fit{&u, &y, 0, 600};
-  const double top = *std::max_element(u.begin(), u.begin() + 600);
-  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), fit, {}).model;
-  const RefitResult r =
-      AddBlock(nominal, Effect::kSaturation, Location::kInput, StateVariable::kPosition, fit, {}, LimitSides::kUpper);
-  ASSERT_EQ(r.model.blocks.size(), 1u);
-  EXPECT_LE(r.model.blocks[0].params[1], top);  // at the extreme, or inside when it clips noise
-  // The refit of a model whose limit lies out of the segment's reach (a flat cost) moves it there.
-  AugmentedModel far = nominal;
-  far.blocks.push_back({Effect::kSaturation, Location::kInput, {-HUGE_VAL, 5.0}, StateVariable::kPosition});
-  EXPECT_DOUBLE_EQ(RefitModel(far, fit, {}).model.blocks[0].params[1], top);
-}
-
 // Stiction whose kinetic band is well below its static band, on steps: the backlash start settles on a
 // play between the two, and only a joint move of both bands (static up, kinetic down) opens the jump.
 TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
