@@ -66,8 +66,6 @@ struct RefitResult {
 };
 
 // Jointly refits every number of `model` (linear block, maps, offset, initial state, block parameters).
-// A saturation limit that no sample of the segment reaches is set to the extreme of the signal it acts
-// on there (AddBlock likewise).
 RefitResult RefitModel(const AugmentedModel& model, const Segment& data, const RefitOptions& options);
 // Which limits of a saturation-type block are estimated (the others stay infinite).
 enum class LimitSides { kAny, kUpper, kLower, kBoth };
