@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <thread>
 
 #include <Eigen/Dense>
@@ -226,8 +227,17 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
 // identification recording exactly as the fitted one (the model otherwise unchanged) is an equally
 // supported model, and validation judges the best of them. The choice is among models the data used
 // for fitting cannot tell apart; the block must still pass every test.
-void ChooseRelayThresholdAmongTies(const Context& c, const Reference& ref, Finding* f) {
-  if (f->model.blocks.size() != 1 || f->model.blocks[0].effect != Effect::kHysteresis) return;
+// The same holds for the fit on the fitting part and the held-out tail (a closed loop's reference steps
+// make the input jump across a run of thresholds: retired seeds 800 278 and 800 314, where the middle
+// of the run switched on moves in the tail that the device ignores, and the tail showed the relay
+// worse than none): when the tail does not confirm the relay, every threshold that predicts the
+// fitting part exactly as the fitted one is equally supported, and the tail judges the best of them.
+// `model` is varied; `from`..`to` of the identification recording is where predictions must agree (or
+// the whole recording with `to` = 0); `mse` scores a candidate on the data that judge it.
+bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, std::size_t from, std::size_t to,
+                                 const std::function<double(const AugmentedModel&)>& mse) {
+  if (model->blocks.size() != 1 || model->blocks[0].effect != Effect::kHysteresis) return false;
+  const std::size_t end = to == 0 ? c.n : to;
   std::vector<double> mags;
   for (const Vec* u : {&c.ident.u, &c.valid.u})
     for (double v : *u) mags.push_back(std::abs(v));
@@ -236,26 +246,41 @@ void ChooseRelayThresholdAmongTies(const Context& c, const Reference& ref, Findi
   std::vector<double> values;
   const std::size_t stride = std::max<std::size_t>(1, mags.size() / 400);
   for (std::size_t k = 0; k + 1 < mags.size(); k += stride) values.push_back(0.5 * (mags[k] + mags[k + 1]));
-  const Vec pred = f->model.simulate(c.ident.u);
-  const double sse0 = SumSquaredError(f->model, c.full);
-  AugmentedModel best = f->model;
-  double best_mse = Mse(c.ValidationResidual(f->model), c.skip, c.nv);
+  const Vec pred = model->simulate(c.ident.u);
+  const Segment part{&c.ident.u, &c.ident.y, from, end};
+  const double sse0 = SumSquaredError(*model, part);
+  AugmentedModel best = *model;
+  double best_mse = mse(*model);
   for (double beta : values) {
-    AugmentedModel t = f->model;
+    AugmentedModel t = *model;
     t.blocks[0].params[0] = beta;
     std::string err;
     if (!t.blocks[0].IsValid(&err)) continue;
     const Vec p = t.simulate(c.ident.u);
     double diff = 0.0;
-    for (std::size_t i = c.skip; i < p.size(); ++i) diff = std::max(diff, std::abs(p[i] - pred[i]));
-    if (!(diff <= 1e-9 * (1.0 + std::sqrt(sse0 / std::max<double>(c.n - c.skip, 1))))) continue;
-    const double mse = Mse(c.ValidationResidual(t), c.skip, c.nv);
-    if (mse < best_mse) best_mse = mse, best = t;
+    for (std::size_t i = from; i < end && i < p.size(); ++i) diff = std::max(diff, std::abs(p[i] - pred[i]));
+    if (!(diff <= 1e-9 * (1.0 + std::sqrt(sse0 / std::max<double>(end - from, 1))))) continue;
+    const double m = mse(t);
+    if (m < best_mse) best_mse = m, best = t;
   }
-  if (best.blocks[0].params[0] == f->model.blocks[0].params[0]) return;
-  f->model = best;
-  f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(best), c.skip, c.nv, f->extra_parameters,
+  if (best.blocks[0].params[0] == model->blocks[0].params[0]) return false;
+  *model = best;
+  return true;
+}
+
+void ChooseRelayThresholdAmongTies(const Context& c, const Reference& ref, Finding* f) {
+  const auto valid_mse = [&](const AugmentedModel& m) { return Mse(c.ValidationResidual(m), c.skip, c.nv); };
+  if (!BestRelayThresholdAmongTies(c, &f->model, c.skip, 0, valid_mse)) return;
+  f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(f->model), c.skip, c.nv, f->extra_parameters,
                             c.o.validation_z);
+}
+
+void ChooseRelayThresholdAmongFittingTies(const Context& c, const Reference& ref, Finding* f) {
+  const auto tail_mse = [&](const AugmentedModel& m) { return Mse(c.IdentResidual(m), c.nfit, c.n); };
+  if (!BestRelayThresholdAmongTies(c, &f->fitted, c.skip, c.nfit, tail_mse)) return;
+  f->blocks = f->fitted.blocks;
+  f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(f->fitted), c.nfit, c.n, f->extra_parameters,
+                         c.o.significance_z);
 }
 
 // The model's nominal part alone, its parameters as fitted with the blocks.
@@ -339,6 +364,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
                            c.o.validation_z);
   if (f.holdout.significant != f.validation.significant) ReconcileFits(c, ref, effect, location, chosen, &f);
+  if (!f.holdout.significant) ChooseRelayThresholdAmongFittingTies(c, ref, &f);
   if (f.holdout.significant && !f.validation.significant) ChooseRelayThresholdAmongTies(c, ref, &f);
   bool meaningful = true;
   for (const auto& b : f.blocks)

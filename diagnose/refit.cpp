@@ -257,6 +257,18 @@ Vec LimitCandidates(const Vec& v, bool upper) {
   out.erase(std::remove_if(out.begin(), out.end(),
                            [&](double x) { return std::isfinite(x) && (upper ? x >= highest : x <= lowest); }),
             out.end());
+  // On an input of few levels (PRBS: two) every quantile above is the extreme level itself, which
+  // clamps nothing, and no limit would be tried at all: a limit that moves the extreme level inwards
+  // (the one kind of saturation such an input can show) then starts between the extreme and the next
+  // level inwards, where the cost is smooth in the limit.
+  if (std::none_of(out.begin(), out.end(), [](double x) { return std::isfinite(x); })) {
+    const auto inward = upper ? std::lower_bound(sorted.begin(), sorted.end(), highest - 0.01 * range)
+                              : std::upper_bound(sorted.begin(), sorted.end(), lowest + 0.01 * range);
+    if (upper ? inward != sorted.begin() : inward != sorted.end()) {
+      const double extreme = upper ? highest : lowest, next = upper ? *(inward - 1) : *inward;
+      for (double f : {0.5, 0.9}) out.push_back(next + f * (extreme - next));
+    }
+  }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -840,7 +852,7 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);
     SearchOnlyParameters(&m, s, o);
-    RefitResult r = Finish(m, s);
+      RefitResult r = Finish(m, s);
     if (r.sse < best.sse) best = r;
   }
   if (!std::isfinite(best.sse)) best = RefitModel(base, s, o);  // no admissible grid point

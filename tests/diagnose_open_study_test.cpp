@@ -279,5 +279,32 @@ TEST(OpenStudy, DelayAgainstARicherNumeratorAndEffectsOutsideTheHeldOutTail) {
   }
 }
 
+// An input saturation on PRBS (retired seed 800 111, nominal given): every quantile of a two-level
+// input is one of its levels, so no finite limit was tried, and hysteresis with a threshold never
+// crossed (a constant input offset) was named instead.
+TEST(OpenStudy, InputSaturationOnATwoLevelInput) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kSaturation;
+  so.seed = 800111;
+  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.verdict, Effect::kSaturation) << r.message;
+  EXPECT_EQ(r.verdict_location, Location::kInput) << r.message;
+}
+
+// A relay in a closed loop (retired seed 800 314, linear:2,2,1): the reference steps make the input jump
+// across a run of thresholds, all of which predict the fitting part alike; the middle of that run (the
+// fit's choice) switched on moves in the held-out tail that the device ignores, the tail showed the
+// relay worse than none (MSE 1.23x the baseline's) and the fit was called failed. The tail now judges
+// the best threshold among those the fitting part cannot tell apart.
+TEST(OpenStudy, RelayThresholdAmongTheFittingPartsTiesIsJudgedOnTheHeldOutTail) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kHysteresis;
+  so.seed = 800314;
+  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.verdict, Effect::kHysteresis) << r.message;
+}
+
 }  // namespace
 }  // namespace hw::diagnose

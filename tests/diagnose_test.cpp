@@ -287,6 +287,32 @@ TEST(Refit, ASaturationBetweenTwoInputLevelsIsFoundFromTheGapBetweenThem) {
   EXPECT_LT(r.sse, 2.0 * u.size() * 0.01 * 0.01);
 }
 
+// On a two-level input (PRBS) every quantile of the input is one of its two levels: a limit there clips
+// nothing, and no finite limit was tried at all (the fit returned no block). A limit that moves the low
+// level inwards starts between the two levels and is refined to the truth. The nominal's maps are held
+// (with them refitted, an affine change of a two-level input is absorbed by the gain, the output map and
+// the offset).
+TEST(Refit, ASaturationOfATwoLevelInputIsFound) {
+  std::mt19937_64 rng(31);
+  const Vec u = FewLevelSteps(rng, {-1.0, 0.7}, 900);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.7}, {0.3}, 0};
+  truth.nominal.output = StaticMap::Polynomial({1.0, 0.1, 0.2});
+  truth.blocks.push_back({Effect::kSaturation, Location::kInput, {-0.8, HUGE_VAL}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, 0.01);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  RefitOptions o;
+  o.refit_maps = false;
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, o).model;
+  const RefitResult r = AddBlock(nominal, Effect::kSaturation, Location::kInput, StateVariable::kPosition, seg, o,
+                                 LimitSides::kLower);
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_NEAR(r.model.blocks[0].params[0], -0.8, 0.03);
+  EXPECT_LT(r.sse, 2.0 * u.size() * 0.01 * 0.01);
+}
+
 // Stiction whose kinetic band is well below its static band, on steps: the backlash start settles on a
 // play between the two, and only a joint move of both bands (static up, kinetic down) opens the jump.
 TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
