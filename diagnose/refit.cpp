@@ -852,7 +852,7 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);
     SearchOnlyParameters(&m, s, o);
-      RefitResult r = Finish(m, s);
+    RefitResult r = Finish(m, s);
     if (r.sse < best.sse) best = r;
   }
   if (!std::isfinite(best.sse)) best = RefitModel(base, s, o);  // no admissible grid point
