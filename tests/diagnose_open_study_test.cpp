@@ -197,6 +197,21 @@ OpenDiagnosis DiagnoseOpenScenario(const OpenScenarioOptions& so, bool fitted, D
   return d;
 }
 
+// The report on one scenario (effect, location, seed) diagnosed with its true nominal given.
+DiagnoseReport DiagnoseWithNominalGiven(Effect effect, Location location, unsigned seed) {
+  OpenScenarioOptions so;
+  so.effect = effect;
+  so.location = location;
+  so.seed = seed;
+  return DiagnoseOpenScenario(so, /*fitted=*/false).report;
+}
+
+// Whether the report names `effect` at `location` (its message otherwise).
+::testing::AssertionResult Names(const DiagnoseReport& r, Effect effect, Location location) {
+  if (r.ok && r.verdict == effect && r.verdict_location == location) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << r.message;
+}
+
 // A null recording whose fitted nominal stays stuck in a poor optimum (held-out RMSE 2.2x the noise): the
 // refit of an input quantizer of a small step freed the nominal part under it, which alone (the block
 // removed) reaches the noise, and was named as an effect. The blocks must make the difference, otherwise
@@ -252,11 +267,7 @@ TEST(OpenStudy, DelayTiedWithARicherNominalAndDelayFromFreshStarts) {
 // the blocks seemed to make no difference and the fit was called failed (a poor optimum freed). On the
 // fitting part they do: removing them there is significantly worse.
 TEST(NominalStatus, ALimitReachedOnlyInTheFittingPartIsNeededThere) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kStateSaturation;
-  so.location = Location::kState;
-  so.seed = 700190;
-  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kStateSaturation, Location::kState, 700190);
   ASSERT_TRUE(r.ok) << r.message;
   EXPECT_EQ(r.verdict, Effect::kStateSaturation) << r.message;
   EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
@@ -283,13 +294,8 @@ TEST(OpenStudy, DelayAgainstARicherNumeratorAndEffectsOutsideTheHeldOutTail) {
 // input is one of its levels, so no finite limit was tried, and hysteresis with a threshold never
 // crossed (a constant input offset) was named instead.
 TEST(OpenStudy, InputSaturationOnATwoLevelInput) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kSaturation;
-  so.seed = 800111;
-  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
-  ASSERT_TRUE(r.ok) << r.message;
-  EXPECT_EQ(r.verdict, Effect::kSaturation) << r.message;
-  EXPECT_EQ(r.verdict_location, Location::kInput) << r.message;
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kSaturation, Location::kInput, 800111), Effect::kSaturation,
+                    Location::kInput));
 }
 
 // A relay in a closed loop (retired seed 800 314, linear:2,2,1): the reference steps make the input jump
@@ -298,12 +304,8 @@ TEST(OpenStudy, InputSaturationOnATwoLevelInput) {
 // relay worse than none (MSE 1.23x the baseline's) and the fit was called failed. The tail now judges
 // the best threshold among those the fitting part cannot tell apart.
 TEST(OpenStudy, RelayThresholdAmongTheFittingPartsTiesIsJudgedOnTheHeldOutTail) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kHysteresis;
-  so.seed = 800314;
-  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false).report;
-  ASSERT_TRUE(r.ok) << r.message;
-  EXPECT_EQ(r.verdict, Effect::kHysteresis) << r.message;
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kHysteresis, Location::kInput, 800314), Effect::kHysteresis,
+                    Location::kInput));
 }
 
 }  // namespace
