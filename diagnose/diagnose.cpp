@@ -232,12 +232,11 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
 // of the run switched on moves in the tail that the device ignores, and the tail showed the relay
 // worse than none): when the tail does not confirm the relay, every threshold that predicts the
 // fitting part exactly as the fitted one is equally supported, and the tail judges the best of them.
-// `model` is varied; `from`..`to` of the identification recording is where predictions must agree (or
-// the whole recording with `to` = 0); `mse` scores a candidate on the data that judge it.
-bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, std::size_t from, std::size_t to,
+// `model` is varied; `agree` (a part of the identification recording) is where predictions must agree;
+// `mse` scores a candidate on the data that judge it.
+bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, const Segment& agree,
                                  const std::function<double(const AugmentedModel&)>& mse) {
   if (model->blocks.size() != 1 || model->blocks[0].effect != Effect::kHysteresis) return false;
-  const std::size_t end = to == 0 ? c.n : to;
   std::vector<double> mags;
   for (const Vec* u : {&c.ident.u, &c.valid.u})
     for (double v : *u) mags.push_back(std::abs(v));
@@ -247,8 +246,7 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, std::s
   const std::size_t stride = std::max<std::size_t>(1, mags.size() / 400);
   for (std::size_t k = 0; k + 1 < mags.size(); k += stride) values.push_back(0.5 * (mags[k] + mags[k + 1]));
   const Vec pred = model->simulate(c.ident.u);
-  const Segment part{&c.ident.u, &c.ident.y, from, end};
-  const double sse0 = SumSquaredError(*model, part);
+  const double sse0 = SumSquaredError(*model, agree);
   AugmentedModel best = *model;
   double best_mse = mse(*model);
   for (double beta : values) {
@@ -258,8 +256,9 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, std::s
     if (!t.blocks[0].IsValid(&err)) continue;
     const Vec p = t.simulate(c.ident.u);
     double diff = 0.0;
-    for (std::size_t i = from; i < end && i < p.size(); ++i) diff = std::max(diff, std::abs(p[i] - pred[i]));
-    if (!(diff <= 1e-9 * (1.0 + std::sqrt(sse0 / std::max<double>(end - from, 1))))) continue;
+    for (std::size_t i = agree.skip; i < agree.End() && i < p.size(); ++i)
+      diff = std::max(diff, std::abs(p[i] - pred[i]));
+    if (!(diff <= 1e-9 * (1.0 + std::sqrt(sse0 / std::max<double>(agree.Count(), 1))))) continue;
     const double m = mse(t);
     if (m < best_mse) best_mse = m, best = t;
   }
@@ -270,14 +269,14 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, std::s
 
 void ChooseRelayThresholdAmongTies(const Context& c, const Reference& ref, Finding* f) {
   const auto valid_mse = [&](const AugmentedModel& m) { return Mse(c.ValidationResidual(m), c.skip, c.nv); };
-  if (!BestRelayThresholdAmongTies(c, &f->model, c.skip, 0, valid_mse)) return;
+  if (!BestRelayThresholdAmongTies(c, &f->model, c.full, valid_mse)) return;
   f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(f->model), c.skip, c.nv, f->extra_parameters,
                             c.o.validation_z);
 }
 
 void ChooseRelayThresholdAmongFittingTies(const Context& c, const Reference& ref, Finding* f) {
   const auto tail_mse = [&](const AugmentedModel& m) { return Mse(c.IdentResidual(m), c.nfit, c.n); };
-  if (!BestRelayThresholdAmongTies(c, &f->fitted, c.skip, c.nfit, tail_mse)) return;
+  if (!BestRelayThresholdAmongTies(c, &f->fitted, c.fit, tail_mse)) return;
   f->blocks = f->fitted.blocks;
   f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(f->fitted), c.nfit, c.n, f->extra_parameters,
                          c.o.significance_z);
