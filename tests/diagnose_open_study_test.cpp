@@ -323,5 +323,15 @@ TEST(StictionFit, BandsBetweenCoarseGridPointsAreRefined) {
                     Location::kInput));
 }
 
+// Stiction whose identification recording never sticks and slips between the kinetic band and static
+// bands up to 1.64 (retired seed 900 119, closed loop, nominal given): all those static bands predict it
+// identically, the fit took the lowest (equal bands, backlash), and validation showed a stick-slip of
+// 65 noise standard deviations that backlash leaves. Validation now judges the static band among the
+// identification recording's ties.
+TEST(OpenStudy, StaticBandAmongTheIdentificationTiesIsJudgedOnValidation) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kStiction, Location::kInput, 900119), Effect::kStiction,
+                    Location::kInput));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
