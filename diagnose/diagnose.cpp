@@ -219,6 +219,13 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
   }
 }
 
+// Whether predictions a and b agree on `agree` to rounding (`scale`: the size of the residuals there).
+bool PredictsAlike(const Vec& a, const Vec& b, const Segment& agree, double scale) {
+  for (std::size_t i = agree.skip; i < agree.End() && i < a.size() && i < b.size(); ++i)
+    if (!(std::abs(a[i] - b[i]) <= 1e-9 * (1.0 + scale))) return false;
+  return true;
+}
+
 // A relay's threshold is seen only through which input moves cross it: on an input of few levels (steps,
 // PRBS) every threshold between two levels reached gives the same prediction, and the identification
 // recording cannot tell where in that run the device switches. Validation, with other levels, can: a
@@ -246,7 +253,7 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, const 
   const std::size_t stride = std::max<std::size_t>(1, mags.size() / 400);
   for (std::size_t k = 0; k + 1 < mags.size(); k += stride) values.push_back(0.5 * (mags[k] + mags[k + 1]));
   const Vec pred = model->simulate(c.ident.u);
-  const double sse0 = SumSquaredError(*model, agree);
+  const double scale = std::sqrt(SumSquaredError(*model, agree) / std::max<double>(agree.Count(), 1));
   AugmentedModel best = *model;
   double best_mse = mse(*model);
   for (double beta : values) {
@@ -254,11 +261,7 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, const 
     t.blocks[0].params[0] = beta;
     std::string err;
     if (!t.blocks[0].IsValid(&err)) continue;
-    const Vec p = t.simulate(c.ident.u);
-    double diff = 0.0;
-    for (std::size_t i = agree.skip; i < agree.End() && i < p.size(); ++i)
-      diff = std::max(diff, std::abs(p[i] - pred[i]));
-    if (!(diff <= 1e-9 * (1.0 + std::sqrt(sse0 / std::max<double>(agree.Count(), 1))))) continue;
+    if (!PredictsAlike(t.simulate(c.ident.u), pred, agree, scale)) continue;
     const double m = mse(t);
     if (m < best_mse) best_mse = m, best = t;
   }
@@ -306,12 +309,6 @@ Vec StaticBandsAbove(const Context& c, double kinetic) {
   if (!(hi > lo)) return bands;
   for (int k = 1; k <= kStaticBandTieSteps; ++k) bands.push_back(kinetic + (hi - lo) * k / kStaticBandTieSteps);
   return bands;
-}
-
-bool PredictsAlike(const Vec& a, const Vec& b, const Segment& agree, double scale) {
-  for (std::size_t i = agree.skip; i < agree.End() && i < a.size() && i < b.size(); ++i)
-    if (!(std::abs(a[i] - b[i]) <= 1e-9 * (1.0 + scale))) return false;
-  return true;
 }
 
 void ChooseStaticBandAmongTies(const Context& c, const Reference& ref, Finding* f) {
