@@ -226,6 +226,33 @@ bool PredictsAlike(const Vec& a, const Vec& b, const Segment& agree, double scal
   return true;
 }
 
+// Whether the values of a tie search that predict alike form one run (the first that does not ends the
+// search) or lie scattered among others (each is skipped on its own).
+enum class TieRun { kContiguous, kScattered };
+
+// Among `values` of parameter `param` of the model's one block, the model that predicts `agree` exactly as
+// `model` does and scores lowest by `mse` (the data that judge it); `model` itself when none scores lower.
+AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, int param, const std::vector<double>& values,
+                             const Segment& agree, TieRun run, const std::function<double(const AugmentedModel&)>& mse) {
+  const Vec pred = model.simulate(c.ident.u);
+  const double scale = std::sqrt(SumSquaredError(model, agree) / std::max<double>(agree.Count(), 1));
+  AugmentedModel best = model;
+  double best_mse = mse(model);
+  for (double value : values) {
+    AugmentedModel t = model;
+    t.blocks[0].params[param] = value;
+    std::string err;
+    if (!t.blocks[0].IsValid(&err)) continue;
+    if (!PredictsAlike(t.simulate(c.ident.u), pred, agree, scale)) {
+      if (run == TieRun::kContiguous) break;
+      continue;
+    }
+    const double m = mse(t);
+    if (m < best_mse) best_mse = m, best = t;
+  }
+  return best;
+}
+
 // A relay's threshold is seen only through which input moves cross it: on an input of few levels (steps,
 // PRBS) every threshold between two levels reached gives the same prediction, and the identification
 // recording cannot tell where in that run the device switches. Validation, with other levels, can: a
@@ -252,19 +279,7 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, const 
   std::vector<double> values;
   const std::size_t stride = std::max<std::size_t>(1, mags.size() / 400);
   for (std::size_t k = 0; k + 1 < mags.size(); k += stride) values.push_back(0.5 * (mags[k] + mags[k + 1]));
-  const Vec pred = model->simulate(c.ident.u);
-  const double scale = std::sqrt(SumSquaredError(*model, agree) / std::max<double>(agree.Count(), 1));
-  AugmentedModel best = *model;
-  double best_mse = mse(*model);
-  for (double beta : values) {
-    AugmentedModel t = *model;
-    t.blocks[0].params[0] = beta;
-    std::string err;
-    if (!t.blocks[0].IsValid(&err)) continue;
-    if (!PredictsAlike(t.simulate(c.ident.u), pred, agree, scale)) continue;
-    const double m = mse(t);
-    if (m < best_mse) best_mse = m, best = t;
-  }
+  AugmentedModel best = BestAmongTies(c, *model, 0, values, agree, TieRun::kScattered, mse);
   if (best.blocks[0].params[0] == model->blocks[0].params[0]) return false;
   *model = best;
   return true;
@@ -314,22 +329,12 @@ Vec StaticBandsAbove(const Context& c, double kinetic) {
 void ChooseStaticBandAmongTies(const Context& c, const Reference& ref, Finding* f) {
   AugmentedModel& m = f->model;
   if (m.blocks.size() != 1 || m.blocks[0].effect != Effect::kStiction || HasStickSlipJump(m.blocks[0])) return;
-  const Vec pred = m.simulate(c.ident.u);
-  const double scale = std::sqrt(SumSquaredError(m, c.full) / std::max<double>(c.full.Count(), 1));
-  const Vec e0 = c.ValidationResidual(m);
-  AugmentedModel best = m;
-  double best_mse = Mse(e0, c.skip, c.nv);
-  for (double fs : StaticBandsAbove(c, m.blocks[0].params[1])) {
-    AugmentedModel t = m;
-    t.blocks[0].params[0] = fs;
-    std::string err;
-    if (!t.blocks[0].IsValid(&err)) continue;
-    if (!PredictsAlike(t.simulate(c.ident.u), pred, c.full, scale)) break;  // the tie ends
-    const double v = Mse(c.ValidationResidual(t), c.skip, c.nv);
-    if (v < best_mse) best_mse = v, best = t;
-  }
+  const auto valid_mse = [&](const AugmentedModel& t) { return Mse(c.ValidationResidual(t), c.skip, c.nv); };
+  const AugmentedModel best =
+      BestAmongTies(c, m, 0, StaticBandsAbove(c, m.blocks[0].params[1]), c.full, TieRun::kContiguous, valid_mse);
   if (!HasStickSlipJump(best.blocks[0])) return;
-  if (!c.Compare(e0, c.ValidationResidual(best), c.skip, c.nv, 1, c.o.validation_z).significant) return;
+  if (!c.Compare(c.ValidationResidual(m), c.ValidationResidual(best), c.skip, c.nv, 1, c.o.validation_z).significant)
+    return;
   m = best;
   f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(m), c.skip, c.nv, f->extra_parameters,
                             c.o.validation_z);
