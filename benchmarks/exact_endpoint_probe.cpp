@@ -4,6 +4,7 @@
 // the bound most is the one a branch and bound should split for it.
 //   exact_endpoint_probe --result paper_examples/results/exact_snr31_seed1/exact.json --parameter gamma2 --max
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 
 #include <CLI/CLI.hpp>
@@ -13,8 +14,10 @@
 #include "core/cerone_example.hpp"
 #include "dss/hw_outer_set.hpp"
 #include "exact/box_evaluation.hpp"
+#include "exact/branch_and_bound.hpp"
 #include "exact/dynamics_forms.hpp"
 #include "exact/inner_hull.hpp"
+#include "exact/membership.hpp"
 #include "exact/lifted_lp.hpp"
 #include "exact/lp_solver.hpp"
 
@@ -65,6 +68,56 @@ void ProbeSlab(const ProbeContext& c, ex::ParamBox box, const ex::Objective& obj
   }
 }
 
+
+// D's known extent per entry: the inner hull's range over its certified points (the box's own range for a form).
+ex::ParamBox InnerExtent(const ex::LiftedData& lifted, const ex::InnerHull& hull, const ex::ParamBox& box) {
+  ex::ParamBox extent = box;
+  for (int k = 0; k < lifted.layout.count(); ++k) {
+    double lo = box[k].hi, hi = box[k].lo;
+    for (const auto& pt : hull.points) lo = std::min(lo, pt.theta[k]), hi = std::max(hi, pt.theta[k]);
+    if (lo <= hi) extent[k] = ex::Interval(lo, hi);
+  }
+  return extent;
+}
+
+// One endpoint search as a sweep runs it (from the whole box, towards the inner extreme within the default
+// target's allowance): how far a budget of LPs gets under a split rule.
+void ProbeSearch(const ProbeContext& c, const ex::ParamBox& box, const ex::Objective& objective, double extreme,
+                 const ex::ParamBox& extent, int budget, ex::EndpointSplit split) {
+  const int p = objective.parameter;
+  const double width = extent[p].hi - extent[p].lo;
+  ex::ObjectiveSearchOptions search;
+  search.lp_budget = budget;
+  search.split = split;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = ex::SearchObjective(c.lifted, box, {box}, objective, extreme, 0.125 * width, search, c.options,
+                                     c.solver, &extent);
+  fmt::print("search ({}): bound {:.7f}, gap to inner {:.3g} = {:.3f} of the inner width, {} LPs, {} boxes left, {:.1f} s\n",
+             ex::ToString(split), r.bound, std::abs(r.bound - extreme), std::abs(r.bound - extreme) / width, r.lps,
+             r.boxes_left, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+// The endpoint's bound in each of `count` equal slices of entry `along`, with the membership slack of each
+// slice's LP point (its parameter values, checked exactly; negative: outside D).
+void ProbeSlices(const ProbeContext& c, const ex::ParamBox& box, const ex::Objective& objective, int along, int count) {
+  const auto& lay = c.lifted.layout;
+  const double w = (box[along].hi - box[along].lo) / count;
+  for (int i = 0; i < count; ++i) {
+    ex::ParamBox b = box;
+    b[along] = ex::Interval(box[along].lo + i * w, box[along].lo + (i + 1) * w);
+    ex::PropagateForms(c.lifted, b);
+    const auto e = ex::BoundObjective(c.lifted, b, objective, c.options, c.solver, {}, c.ratio);
+    if (e.verdict == ex::BoxVerdict::kPruned || !e.bound || e.point.size() < static_cast<std::size_t>(lay.count())) {
+      fmt::print("slice [{:.7f}, {:.7f}]: {}\n", b[along].lo, b[along].hi,
+                 e.verdict == ex::BoxVerdict::kPruned ? "empty (pruned)" : "no bound");
+      continue;
+    }
+    const std::vector<double> theta(e.point.begin(), e.point.begin() + lay.count());
+    const auto m = ex::CheckMembership(c.lifted, theta, c.solver);
+    fmt::print("slice [{:.7f}, {:.7f}]: bound {:.7f}, its LP point's membership slack {:.3g}\n", b[along].lo, b[along].hi,
+               *e.bound, m.slack);
+  }
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,6 +141,14 @@ int main(int argc, char** argv) {
   app.add_option("--rounds", rounds, "with --slab: rounds of bounding every other parameter in the slab");
   app.add_flag("--start-box", start_box, "the run's start box (the D^ss box) instead of the box it proved");
   app.add_flag("--bound-only", bound_only, "the whole box's bound only (no narrowing)");
+  int search_budget = 0;
+  app.add_option("--search", search_budget, "instead of narrowing: one endpoint search (SearchObjective) with this LP budget");
+  std::string split_name = "dynamics", slices;
+  app.add_option("--split", split_name, "with --search: what the search halves (as exact_tables --split)");
+  app.add_option("--slices", slices, "NAME:K instead of narrowing: the bound in each of K equal slices of NAME's range");
+  std::vector<std::string> pinned;
+  app.add_option("--pin", pinned, "entries fixed at the inner extreme's values (to 1e-7 relative) before probing")
+      ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   std::ifstream in(result_path);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -115,6 +176,11 @@ int main(int argc, char** argv) {
   for (const auto& pt : hull.points)
     if (extreme.empty() || (maximise ? pt.theta[p] > extreme[p] : pt.theta[p] < extreme[p])) extreme = pt.theta;
   fmt::print("inner extreme of {}: {:.7f}\n", parameter, extreme[p]);
+  for (const auto& name : pinned) {
+    const int k = static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+    if (k >= lifted.layout.count()) throw std::invalid_argument("--pin: unknown parameter " + name);
+    box[k] = ex::Interval(extreme[k] - 1e-7 * std::abs(extreme[k]), extreme[k] + 1e-7 * std::abs(extreme[k]));
+  }
   box = ex::WithFormRanges(lifted, box);
   ex::PropagateForms(lifted, box);
   const ex::Objective objective{p, maximise};
@@ -128,8 +194,23 @@ int main(int argc, char** argv) {
   fmt::print("whole box: bound {:.7f} (gap to inner {:.3g}, {} LPs, {:.2f} s)\n", b0, std::abs(b0 - extreme[p]), lps0,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (bound_only) return 0;
+  const ProbeContext context{lifted, options, *solver, ratio};
+  if (search_budget > 0) {
+    ex::EndpointSplit split;
+    if (!ex::ParseEndpointSplit(split_name, &split)) throw std::invalid_argument("unknown --split " + split_name);
+    ProbeSearch(context, box, objective, extreme[p], InnerExtent(lifted, hull, box), search_budget, split);
+    return 0;
+  }
+  if (!slices.empty()) {
+    const auto colon = slices.find(':');
+    const std::string along = slices.substr(0, colon);
+    const int k = static_cast<int>(std::find(names.begin(), names.end(), along) - names.begin());
+    if (colon == std::string::npos || k >= lifted.layout.count()) throw std::invalid_argument("--slices NAME:K, NAME a parameter");
+    ProbeSlices(context, box, objective, k, std::stoi(slices.substr(colon + 1)));
+    return 0;
+  }
   if (slab > 0.0) {
-    ProbeSlab({lifted, options, *solver, ratio}, box, objective, extreme[p], b0, slab, rounds);
+    ProbeSlab(context, box, objective, extreme[p], b0, slab, rounds);
     return 0;
   }
   std::vector<double> at = extreme;

@@ -34,8 +34,9 @@ std::vector<int> DynamicsEntries(const LiftedData& data, std::size_t box_size) {
   return entries;
 }
 
-// The entries an endpoint of parameter p halves with EndpointSplit::kFamily: the dynamics' and p's family.
-std::vector<int> FamilyEntries(const LiftedData& data, int p, std::size_t box_size) {
+// The entries an endpoint of parameter p halves with EndpointSplit::kFamily (the dynamics' and p's family) or
+// kDynamicsGamma (the dynamics', and the gammas for an a_i).
+std::vector<int> FamilyEntries(const LiftedData& data, int p, EndpointSplit split, std::size_t box_size) {
   const auto& lay = data.layout;
   auto in = [](int k, int begin, int count) { return k >= begin && k < begin + count; };
   const int nb = lay.count() - lay.b_begin;
@@ -43,8 +44,9 @@ std::vector<int> FamilyEntries(const LiftedData& data, int p, std::size_t box_si
   auto add = [&](int begin, int count) {
     for (int k = begin; k < begin + count; ++k) entries.push_back(k);
   };
-  if (in(p, lay.gamma_begin, lay.num_gamma)) add(lay.gamma_begin, lay.num_gamma);
-  if (in(p, lay.alpha_begin, lay.num_alpha) || in(p, lay.b_begin, nb)) {
+  if (in(p, lay.a_begin, data.structure.na) && split == EndpointSplit::kDynamicsGamma) add(lay.gamma_begin, lay.num_gamma);
+  if (split == EndpointSplit::kFamily && in(p, lay.gamma_begin, lay.num_gamma)) add(lay.gamma_begin, lay.num_gamma);
+  if (split == EndpointSplit::kFamily && (in(p, lay.alpha_begin, lay.num_alpha) || in(p, lay.b_begin, nb))) {
     add(lay.alpha_begin, lay.num_alpha);
     add(lay.b_begin, nb);
   }
@@ -59,9 +61,11 @@ int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& 
 
 int SplitEntry(const LiftedData& data, const ParamBox& box, const ParamBox& start, int p, EndpointSplit split,
                const ParamBox* scale) {
-  if (split != EndpointSplit::kFamily) return SplitParameter(data, box, start);
+  const bool dynamics_gamma = split == EndpointSplit::kDynamicsGamma && p >= data.layout.a_begin &&
+                              p < data.layout.a_begin + data.structure.na;
+  if (split != EndpointSplit::kFamily && !dynamics_gamma) return SplitParameter(data, box, start);
   const ParamBox& reference = scale && scale->size() == box.size() ? *scale : start;
-  return WidestAgainst(FamilyEntries(data, p, std::min(box.size(), start.size())), box, reference, start);
+  return WidestAgainst(FamilyEntries(data, p, split, std::min(box.size(), start.size())), box, reference, start);
 }
 
 std::pair<ParamBox, ParamBox> CutBox(const ParamBox& box, int parameter, double cut) {
@@ -107,12 +111,14 @@ std::string ToString(EndpointSplit split) {
     case EndpointSplit::kDynamics: return "dynamics";
     case EndpointSplit::kAlternate: return "alternate";
     case EndpointSplit::kFamily: return "family";
+    case EndpointSplit::kDynamicsGamma: return "dynamics-gamma";
   }
   return "dynamics";
 }
 
 bool ParseEndpointSplit(const std::string& text, EndpointSplit* split) {
-  return ParseByName(text, {EndpointSplit::kDynamics, EndpointSplit::kAlternate, EndpointSplit::kFamily}, split);
+  return ParseByName(text, {EndpointSplit::kDynamics, EndpointSplit::kAlternate, EndpointSplit::kFamily,
+                                EndpointSplit::kDynamicsGamma}, split);
 }
 
 bool ObjectiveSearchOptions::IsValid(std::string* error) const {

@@ -44,6 +44,9 @@ enum class EndpointSplit {
   kFamily,     // the a_i and forms and the entries of the endpoint's own family (exact_endpoint_probe): the gammas
                // for a gamma, the alphas and b's for an alpha or a b; the entry widest against D's known extent
                // (the inner hull's range; else the search's start) first
+  kDynamicsGamma,  // as kDynamics, except that an a_i endpoint halves the a_i, forms and gammas, the widest against
+                   // D's known extent first: where the LP overreaches D along its strip it rests on beta = b*gamma
+                   // (docs/exact_set.md, "An a_i endpoint's bulge")
 };
 std::string ToString(EndpointSplit split);
 bool ParseEndpointSplit(const std::string& text, EndpointSplit* split);
@@ -75,7 +78,7 @@ struct ObjectiveSearchResult {
 
 // `target`: a value of the objective at a known point of D (the inner hull); the search stops when the bound
 // is within `target_gap` of it. Without a target it spends its budget. `scale` (optional): D's known extent per
-// entry (the inner hull's ranges), against which EndpointSplit::kFamily measures a box's widths.
+// entry (the inner hull's ranges), against which EndpointSplit::kFamily and kDynamicsGamma measure a box's widths.
 ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& start, const std::vector<ParamBox>& boxes,
                                       const Objective& objective, std::optional<double> target, double target_gap,
                                       const ObjectiveSearchOptions& options, const BoxEvaluationOptions& evaluation,

@@ -177,9 +177,10 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
   const auto& lay = data.layout;
   std::vector<nlohmann::json> specs;
   std::vector<Objective> objectives;
-  // D's known extent per entry (the inner hull's range, else the start's): what the family split measures against.
+  // D's known extent per entry (the inner hull's range, else the start's): what the family and dynamics-gamma
+  // splits measure against.
   std::optional<ParamBox> scale;
-  if (inner && split == EndpointSplit::kFamily) {
+  if (inner && (split == EndpointSplit::kFamily || split == EndpointSplit::kDynamicsGamma)) {
     scale = start;
     for (std::size_t k = 0; k < start.size() && k < inner->size(); ++k)
       if ((*inner)[k]) (*scale)[k] = Interval((*inner)[k]->first, (*inner)[k]->second);

@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
     std::string error;
     return exact::ValidLpSolverName(name, &error) ? std::string() : error;
   });
-  app.add_option("--split", split, "what an endpoint's refinement halves: dynamics, alternate or family")
+  app.add_option("--split", split, "what an endpoint's refinement halves: dynamics, alternate, family or dynamics-gamma")
       ->check([](const std::string& name) {
         exact::EndpointSplit parsed;
         return exact::ParseEndpointSplit(name, &parsed) ? std::string() : "expected dynamics, alternate or family";

@@ -216,6 +216,30 @@ class LyingSolver : public LpSolver {
   std::mt19937 rng_{3};
 };
 
+// Where an a_i endpoint's LP overreaches D it rests on beta = b*gamma: kDynamicsGamma lets that endpoint halve
+// a gamma (when it is the widest against D's known extent); every other endpoint still halves the dynamics.
+TEST(BranchAndBound, AnAEndpointUnderDynamicsGammaHalvesTheGammaWidestAgainstDsExtent) {
+  testing::RandomHwInstance inst;
+  for (uint64_t seed = 1;; ++seed) {
+    inst = InstanceOf(seed, 40);
+    if (MakeLiftedData(inst.structure, inst.data).layout.num_gamma > 0) break;
+  }
+  const LiftedData d = MakeLiftedData(inst.structure, inst.data);
+  const auto& lay = d.layout;
+  const ParamBox box = BoxAround(d, inst.theta, 0.01, 0.1);
+  ParamBox extent = box;  // D known to fill the box in every entry but the gammas, a tenth of theirs
+  for (int k = lay.gamma_begin; k < lay.gamma_begin + lay.num_gamma; ++k)
+    extent[k] = Interval(inst.theta[k] - 0.01, inst.theta[k] + 0.01);
+  const auto is_gamma = [&](int k) { return k >= lay.gamma_begin && k < lay.gamma_begin + lay.num_gamma; };
+  const auto is_a = [&](int k) { return k >= lay.a_begin && k < lay.a_begin + d.structure.na; };
+  EXPECT_TRUE(is_gamma(SplitEntry(d, box, box, lay.a_begin, EndpointSplit::kDynamicsGamma, &extent))) << inst.description;
+  EXPECT_TRUE(is_a(SplitEntry(d, box, box, lay.a_begin, EndpointSplit::kDynamics, &extent))) << inst.description;
+  EXPECT_TRUE(is_a(SplitEntry(d, box, box, lay.b_begin, EndpointSplit::kDynamicsGamma, &extent))) << inst.description;
+  EndpointSplit parsed = EndpointSplit::kDynamics;
+  EXPECT_TRUE(ParseEndpointSplit("dynamics-gamma", &parsed));
+  EXPECT_EQ(parsed, EndpointSplit::kDynamicsGamma);
+}
+
 TEST(BranchAndBound, ALyingLpBackendNeitherDropsTheTruthsBoxNorExcludesTheTruth) {
   const auto inst = InstanceOf(11, 60);
   const LiftedData d = MakeLiftedData(inst.structure, inst.data);
@@ -300,6 +324,9 @@ TEST(ExactSoundness, RandomSystemsSeeds151To175FamilySplitPooledRatio) {
 }
 TEST(ExactSoundness, RandomSystemsSeeds176To200AlternateSplitRotatedRatio) {
   CheckSoundness(176, 25, "clp", EndpointSplit::kAlternate, GammaRatio::kRotate);
+}
+TEST(ExactSoundness, RandomSystemsSeeds201To225DynamicsGammaSplit) {
+  CheckSoundness(201, 25, "clp", EndpointSplit::kDynamicsGamma);
 }
 
 TEST(ExactBounds, NarrowerThanTheStartBoxAndTheSameOnEveryExecutor) {
