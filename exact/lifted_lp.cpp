@@ -113,185 +113,252 @@ void LiftedLp::SetRatioObjective(const std::vector<std::pair<int, double>>& term
   }
 }
 
-LiftedLp BuildLiftedLp(const LiftedData& d, const ParamBox& box, Window window, LiftedForm form) {
-  const auto& s = d.structure;
-  const auto& lay = d.layout;
-  const int na = s.na, n_alpha = static_cast<int>(s.output_basis.size()), n_gamma = static_cast<int>(s.input_basis.size());
-  const int j0 = d.first_lag(), nb = s.nb;
-  LiftedLp out;
-  out.window = window;
-  LpProblem& lp = out.lp;
-  auto range = [&](int col) { return ColumnRange(lp, col); };
+namespace {
 
-  // Parameter columns, in the layout's order.
-  out.param_col.resize(lay.count());
-  if (static_cast<int>(box.size()) > lay.count() && box.size() != lay.count() + d.dynamics_forms.size())
-    throw InputError("a box with form ranges needs one per dynamics form");
-  for (int k = 0; k < lay.count(); ++k) out.param_col[k] = lp.AddColumn(box[k].lo, box[k].hi);
-  for (std::size_t f = 0; f < d.dynamics_forms.size() && static_cast<int>(box.size()) > lay.count(); ++f)
-    out.param_col.push_back(lp.AddColumn(box[lay.count() + f].lo, box[lay.count() + f].hi));
-  auto gamma_col = [&](int k) { return out.param_col[lay.gamma_begin + k - 2]; };  // k = 2..n_gamma
-  auto alpha_col = [&](int j) { return out.param_col[lay.alpha_begin + j - 2]; };  // j = 2..n_alpha
-  auto a_col = [&](int i) { return out.param_col[lay.a_begin + i - 1]; };          // i = 1..na
-  // beta_jk = b_j gamma_k (k = 1: b_j itself).
-  out.beta_col.assign(nb - j0 + 1, std::vector<int>(n_gamma, -1));
-  for (int j = j0; j <= nb; ++j) {
-    const int b = out.param_col[lay.b_begin + j - j0];
-    out.beta_col[j - j0][0] = b;
-    for (int k = 2; k <= n_gamma; ++k) {
-      const Interval prod = range(b) * range(gamma_col(k));
-      out.beta_col[j - j0][k - 1] = lp.AddColumn(prod.lo, prod.hi);
-    }
+// BuildLiftedLp's steps, in the order they add columns and rows (the order fixes the LP, and so a simplex
+// basis's meaning and the interior point's rounding: keep it).
+class LiftedLpBuilder {
+ public:
+  LiftedLpBuilder(const LiftedData& d, const ParamBox& box, Window window, LiftedForm form)
+      : d_(d), lay_(d.layout), box_(box), window_(window), form_(form), na_(d.structure.na),
+        n_alpha_(static_cast<int>(d.structure.output_basis.size())),
+        n_gamma_(static_cast<int>(d.structure.input_basis.size())), j0_(d.first_lag()), nb_(d.structure.nb),
+        t_first_(std::max(window.begin + d.structure.na, d.structure.nb)), row_(&out_.lp) {
+    out_.window = window;
   }
-  // c_ij = a_i alpha_j.
-  std::vector<std::vector<int>> c_col(na + 1, std::vector<int>(n_alpha + 1, -1));
-  for (int i = 1; i <= na; ++i)
-    for (int j = 2; j <= n_alpha; ++j) {
-      const Interval prod = range(a_col(i)) * range(alpha_col(j));
-      c_col[i][j] = lp.AddColumn(prod.lo, prod.hi);
-    }
+
+  LiftedLp Build() {
+    AddParameterColumns();
+    AddBetaColumns();
+    AddAlphaProductColumns();
+    AddSampleColumns();
+    AddSlackColumn();
+    AddEquationRows();
+    AddBandRows();
+    AddDynamicsBandProducts();
+    AddFormBandProducts();
+    AddEnvelopes();
+    AddMonotonicityRows();
+    return std::move(out_);
+  }
+
+ private:
+  Interval range(int col) const { return ColumnRange(out_.lp, col); }
+  int gamma_col(int k) const { return out_.param_col[lay_.gamma_begin + k - 2]; }  // k = 2..n_gamma
+  int alpha_col(int j) const { return out_.param_col[lay_.alpha_begin + j - 2]; }  // j = 2..n_alpha
+  int a_col(int i) const { return out_.param_col[lay_.a_begin + i - 1]; }          // i = 1..na
+  int z_col(int t) const { return out_.z_col[t - window_.begin]; }
+  bool has_form_ranges() const { return static_cast<int>(box_.size()) > lay_.count(); }
   // p(alpha, w) over the alpha box, from basis values at w.
-  auto p_range = [&](const std::vector<Interval>& phi) {
+  Interval p_range(const std::vector<Interval>& phi) const {
     Interval p = phi[0];
-    for (int j = 2; j <= n_alpha; ++j) p += range(alpha_col(j)) * phi[j - 1];
+    for (int j = 2; j <= n_alpha_; ++j) p += range(alpha_col(j)) * phi[j - 1];
     return p;
-  };
-  // z_t within its band over the alpha box.
-  const int T = window.end - window.begin;
-  out.z_col.resize(T);
-  for (int t = window.begin; t < window.end; ++t)
-    out.z_col[t - window.begin] = lp.AddColumn(p_range(d.phi_lo[t]).lo, p_range(d.phi_hi[t]).hi);
-  auto z_col = [&](int t) { return out.z_col[t - window.begin]; };
-  // Equations for every t whose lags lie in the window (outputs) and in the record (inputs).
-  const int t_first = std::max(window.begin + na, nb);
-  // w_{i,tau} = a_i z_tau for the lags the equations use.
-  std::vector<std::vector<int>> w_col(na + 1, std::vector<int>(T, -1));
-  for (int t = t_first; t < window.end; ++t)
-    for (int i = 1; i <= na; ++i) {
-      int& col = w_col[i][t - i - window.begin];
-      if (col >= 0) continue;
-      const Interval prod = range(a_col(i)) * range(z_col(t - i));
-      col = lp.AddColumn(prod.lo, prod.hi);
-    }
-  // The slack bound: the largest residual any point of the column box can have.
-  double slack_max = 0.0;
-  for (int t = t_first; t < window.end; ++t) {
-    Interval r = range(z_col(t));
-    for (int i = 1; i <= na; ++i) r += range(w_col[i][t - i - window.begin]);
-    for (int j = j0; j <= nb; ++j)
-      for (int k = 1; k <= n_gamma; ++k) r = r - range(out.beta_col[j - j0][k - 1]) * d.psi[t - j][k - 1];
-    slack_max = std::max({slack_max, -r.lo, r.hi});
   }
-  out.s_col = lp.AddColumn(0.0, form == LiftedForm::kFeasibility ? RoundUp(slack_max) : 0.0);
 
-  RowBuilder row(&lp);
+  // Parameter columns, in the layout's order, then the forms' (when the box has their ranges).
+  void AddParameterColumns() {
+    LpProblem& lp = out_.lp;
+    out_.param_col.resize(lay_.count());
+    if (has_form_ranges() && box_.size() != lay_.count() + d_.dynamics_forms.size())
+      throw InputError("a box with form ranges needs one per dynamics form");
+    for (int k = 0; k < lay_.count(); ++k) out_.param_col[k] = lp.AddColumn(box_[k].lo, box_[k].hi);
+    for (std::size_t f = 0; f < d_.dynamics_forms.size() && has_form_ranges(); ++f)
+      out_.param_col.push_back(lp.AddColumn(box_[lay_.count() + f].lo, box_[lay_.count() + f].hi));
+  }
+
+  // beta_jk = b_j gamma_k (k = 1: b_j itself).
+  void AddBetaColumns() {
+    out_.beta_col.assign(nb_ - j0_ + 1, std::vector<int>(n_gamma_, -1));
+    for (int j = j0_; j <= nb_; ++j) {
+      const int b = out_.param_col[lay_.b_begin + j - j0_];
+      out_.beta_col[j - j0_][0] = b;
+      for (int k = 2; k <= n_gamma_; ++k) {
+        const Interval prod = range(b) * range(gamma_col(k));
+        out_.beta_col[j - j0_][k - 1] = out_.lp.AddColumn(prod.lo, prod.hi);
+      }
+    }
+  }
+
+  // c_ij = a_i alpha_j.
+  void AddAlphaProductColumns() {
+    c_col_.assign(na_ + 1, std::vector<int>(n_alpha_ + 1, -1));
+    for (int i = 1; i <= na_; ++i)
+      for (int j = 2; j <= n_alpha_; ++j) {
+        const Interval prod = range(a_col(i)) * range(alpha_col(j));
+        c_col_[i][j] = out_.lp.AddColumn(prod.lo, prod.hi);
+      }
+  }
+
+  // z_t within its band over the alpha box; w_{i,tau} = a_i z_tau for the lags the equations use (equations for
+  // every t whose lags lie in the window (outputs) and in the record (inputs)).
+  void AddSampleColumns() {
+    const int T = window_.end - window_.begin;
+    out_.z_col.resize(T);
+    for (int t = window_.begin; t < window_.end; ++t)
+      out_.z_col[t - window_.begin] = out_.lp.AddColumn(p_range(d_.phi_lo[t]).lo, p_range(d_.phi_hi[t]).hi);
+    w_col_.assign(na_ + 1, std::vector<int>(T, -1));
+    for (int t = t_first_; t < window_.end; ++t)
+      for (int i = 1; i <= na_; ++i) {
+        int& col = w_col_[i][t - i - window_.begin];
+        if (col >= 0) continue;
+        const Interval prod = range(a_col(i)) * range(z_col(t - i));
+        col = out_.lp.AddColumn(prod.lo, prod.hi);
+      }
+  }
+
+  // The slack, bounded by the largest residual any point of the column box can have (0 in the bounding form).
+  void AddSlackColumn() {
+    double slack_max = 0.0;
+    for (int t = t_first_; t < window_.end; ++t) {
+      Interval r = range(z_col(t));
+      for (int i = 1; i <= na_; ++i) r += range(w_col_[i][t - i - window_.begin]);
+      for (int j = j0_; j <= nb_; ++j)
+        for (int k = 1; k <= n_gamma_; ++k) r = r - range(out_.beta_col[j - j0_][k - 1]) * d_.psi[t - j][k - 1];
+      slack_max = std::max({slack_max, -r.lo, r.hi});
+    }
+    out_.s_col = out_.lp.AddColumn(0.0, form_ == LiftedForm::kFeasibility ? RoundUp(slack_max) : 0.0);
+  }
+
   // Equations: -s <= residual_t <= s. In the bounding form (s = 0) the first row is the equation itself and the
   // second is left free: the same shape as the feasibility form (so a basis carries over), but no pair of
   // opposite inequalities that would leave an interior-point method no interior.
-  for (int t = t_first; t < window.end; ++t) {
-    for (int side = 0; side < 2; ++side) {
-      row.Add(z_col(t), 1.0);
-      for (int i = 1; i <= na; ++i) row.Add(w_col[i][t - i - window.begin], 1.0);
-      for (int j = j0; j <= nb; ++j)
-        for (int k = 1; k <= n_gamma; ++k) row.Add(out.beta_col[j - j0][k - 1], -d.psi[t - j][k - 1]);
-      if (form == LiftedForm::kBounding) {
-        row.Add(out.s_col, side == 0 ? -1.0 : 1.0);
-        if (side == 0) row.EqualTo(0.0);
-        else row.Free();
-      } else if (side == 0) {
-        row.Add(out.s_col, -1.0).AtMost(0.0);
-      } else {
-        row.Add(out.s_col, 1.0).AtLeast(0.0);
+  void AddEquationRows() {
+    for (int t = t_first_; t < window_.end; ++t) {
+      for (int side = 0; side < 2; ++side) {
+        row_.Add(z_col(t), 1.0);
+        for (int i = 1; i <= na_; ++i) row_.Add(w_col_[i][t - i - window_.begin], 1.0);
+        for (int j = j0_; j <= nb_; ++j)
+          for (int k = 1; k <= n_gamma_; ++k) row_.Add(out_.beta_col[j - j0_][k - 1], -d_.psi[t - j][k - 1]);
+        if (form_ == LiftedForm::kBounding) {
+          row_.Add(out_.s_col, side == 0 ? -1.0 : 1.0);
+          if (side == 0) row_.EqualTo(0.0);
+          else row_.Free();
+        } else if (side == 0) {
+          row_.Add(out_.s_col, -1.0).AtMost(0.0);
+        } else {
+          row_.Add(out_.s_col, 1.0).AtLeast(0.0);
+        }
+      }
+      ++out_.num_equations;
+    }
+  }
+
+  // Bands: p(alpha, L_t) <= z_t <= p(alpha, H_t).
+  void AddBandRows() {
+    for (int t = window_.begin; t < window_.end; ++t) {
+      row_.Add(z_col(t), 1.0);
+      for (int j = 2; j <= n_alpha_; ++j) row_.Add(alpha_col(j), -d_.phi_lo[t][j - 1]);
+      row_.AtLeast(d_.phi_lo[t][0]);
+      row_.Add(z_col(t), 1.0);
+      for (int j = 2; j <= n_alpha_; ++j) row_.Add(alpha_col(j), -d_.phi_hi[t][j - 1]);
+      row_.AtMost(d_.phi_hi[t][0]);
+    }
+  }
+
+  // Products of the box factors of a_i with the band factors of z_tau.
+  void AddDynamicsBandProducts() {
+    for (int i = 1; i <= na_; ++i) {
+      const double l = box_[lay_.a_begin + i - 1].lo, u = box_[lay_.a_begin + i - 1].hi;
+      for (int tau = window_.begin; tau < window_.end; ++tau) {
+        const int w = w_col_[i][tau - window_.begin];
+        if (w < 0) continue;
+        const int z = z_col(tau), a = a_col(i);
+        const auto& pl = d_.phi_lo[tau];
+        const auto& ph = d_.phi_hi[tau];
+        // (a - l)(z - pL) >= 0
+        row_.Add(w, 1.0).Add(a, -pl[0]).Add(z, -l);
+        for (int j = 2; j <= n_alpha_; ++j) row_.Add(c_col_[i][j], -pl[j - 1]).Add(alpha_col(j), Interval(l) * pl[j - 1]);
+        row_.AtLeast(-(Interval(l) * pl[0]));
+        // (u - a)(z - pL) >= 0
+        row_.Add(w, -1.0).Add(a, pl[0]).Add(z, u);
+        for (int j = 2; j <= n_alpha_; ++j) row_.Add(c_col_[i][j], pl[j - 1]).Add(alpha_col(j), -(Interval(u) * pl[j - 1]));
+        row_.AtLeast(Interval(u) * pl[0]);
+        // (a - l)(pH - z) >= 0
+        row_.Add(w, -1.0).Add(a, ph[0]).Add(z, l);
+        for (int j = 2; j <= n_alpha_; ++j) row_.Add(c_col_[i][j], ph[j - 1]).Add(alpha_col(j), -(Interval(l) * ph[j - 1]));
+        row_.AtLeast(Interval(l) * ph[0]);
+        // (u - a)(pH - z) >= 0
+        row_.Add(w, 1.0).Add(a, -ph[0]).Add(z, -u);
+        for (int j = 2; j <= n_alpha_; ++j) row_.Add(c_col_[i][j], -ph[j - 1]).Add(alpha_col(j), Interval(u) * ph[j - 1]);
+        row_.AtLeast(-(Interval(u) * ph[0]));
       }
     }
-    ++out.num_equations;
   }
-  // Bands: p(alpha, L_t) <= z_t <= p(alpha, H_t).
-  for (int t = window.begin; t < window.end; ++t) {
-    row.Add(z_col(t), 1.0);
-    for (int j = 2; j <= n_alpha; ++j) row.Add(alpha_col(j), -d.phi_lo[t][j - 1]);
-    row.AtLeast(d.phi_lo[t][0]);
-    row.Add(z_col(t), 1.0);
-    for (int j = 2; j <= n_alpha; ++j) row.Add(alpha_col(j), -d.phi_hi[t][j - 1]);
-    row.AtMost(d.phi_hi[t][0]);
-  }
-  // Products of the box factors of a_i with the band factors of z_tau.
-  for (int i = 1; i <= na; ++i) {
-    const double l = box[lay.a_begin + i - 1].lo, u = box[lay.a_begin + i - 1].hi;
-    for (int tau = window.begin; tau < window.end; ++tau) {
-      const int w = w_col[i][tau - window.begin];
-      if (w < 0) continue;
-      const int z = z_col(tau), a = a_col(i);
-      const auto& pl = d.phi_lo[tau];
-      const auto& ph = d.phi_hi[tau];
-      // (a - l)(z - pL) >= 0
-      row.Add(w, 1.0).Add(a, -pl[0]).Add(z, -l);
-      for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], -pl[j - 1]).Add(alpha_col(j), Interval(l) * pl[j - 1]);
-      row.AtLeast(-(Interval(l) * pl[0]));
-      // (u - a)(z - pL) >= 0
-      row.Add(w, -1.0).Add(a, pl[0]).Add(z, u);
-      for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], pl[j - 1]).Add(alpha_col(j), -(Interval(u) * pl[j - 1]));
-      row.AtLeast(Interval(u) * pl[0]);
-      // (a - l)(pH - z) >= 0
-      row.Add(w, -1.0).Add(a, ph[0]).Add(z, l);
-      for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], ph[j - 1]).Add(alpha_col(j), -(Interval(l) * ph[j - 1]));
-      row.AtLeast(Interval(l) * ph[0]);
-      // (u - a)(pH - z) >= 0
-      row.Add(w, 1.0).Add(a, -ph[0]).Add(z, -u);
-      for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], -ph[j - 1]).Add(alpha_col(j), Interval(u) * ph[j - 1]);
-      row.AtLeast(-(Interval(u) * ph[0]));
-    }
-  }
+
   // The forms f = sum_i c_i a_i of the box: (f - l)(z - pL) >= 0 and its three siblings, with f z_tau =
   // sum_i c_i w_{i,tau} and f p(alpha, .) = sum_i c_i (a_i phi_1 + sum_j c_ij phi_j); only where every w_{i,tau}
   // of the form exists (fewer rows stay a valid relaxation).
-  for (std::size_t f = 0; f < d.dynamics_forms.size() && static_cast<int>(box.size()) > lay.count(); ++f) {
-    const DynamicsForm& form = d.dynamics_forms[f];
-    const int fc = out.param_col[lay.count() + f];
-    row.Add(fc, 1.0);
-    for (int i = 1; i <= na; ++i)
-      if (form[i - 1] != 0.0) row.Add(a_col(i), -form[i - 1]);
-    row.EqualTo(0.0);
-    const double l = box[lay.count() + f].lo, u = box[lay.count() + f].hi;
-    for (int tau = window.begin; tau < window.end; ++tau) {
-      bool all = true;
-      for (int i = 1; i <= na; ++i) all = all && (form[i - 1] == 0.0 || w_col[i][tau - window.begin] >= 0);
-      if (!all) continue;
-      const int z = z_col(tau);
-      // side: +1 for (f - l)(...), -1 for (u - f)(...); band: the factor (z - pL) or (pH - z).
-      for (const auto& [edge, side] : {std::pair{l, 1.0}, std::pair{u, -1.0}})
-        for (const auto* band : {&d.phi_lo[tau], &d.phi_hi[tau]}) {
-          const double zsign = band == &d.phi_lo[tau] ? 1.0 : -1.0;  // z - pL, or pH - z
-          const auto& ph = *band;
-          const double k = side * zsign;  // the sign of f * z in the product
-          for (int i = 1; i <= na; ++i) {
-            if (form[i - 1] == 0.0) continue;
-            row.Add(w_col[i][tau - window.begin], k * form[i - 1]);
-            row.Add(a_col(i), -k * (Interval(form[i - 1]) * ph[0]));
-            for (int j = 2; j <= n_alpha; ++j) row.Add(c_col[i][j], -k * (Interval(form[i - 1]) * ph[j - 1]));
-          }
-          // -side * edge * (z - p) for band lo, i.e. the edge times the band factor.
-          row.Add(z, -k * edge);
-          for (int j = 2; j <= n_alpha; ++j) row.Add(alpha_col(j), k * (Interval(edge) * ph[j - 1]));
-          row.AtLeast(-k * (Interval(edge) * ph[0]));
-        }
+  void AddFormBandProducts() {
+    for (std::size_t f = 0; f < d_.dynamics_forms.size() && has_form_ranges(); ++f) {
+      const DynamicsForm& form = d_.dynamics_forms[f];
+      row_.Add(out_.param_col[lay_.count() + f], 1.0);
+      for (int i = 1; i <= na_; ++i)
+        if (form[i - 1] != 0.0) row_.Add(a_col(i), -form[i - 1]);
+      row_.EqualTo(0.0);
+      const double l = box_[lay_.count() + f].lo, u = box_[lay_.count() + f].hi;
+      for (int tau = window_.begin; tau < window_.end; ++tau) {
+        bool all = true;
+        for (int i = 1; i <= na_; ++i) all = all && (form[i - 1] == 0.0 || w_col_[i][tau - window_.begin] >= 0);
+        if (!all) continue;
+        // side: +1 for (f - l)(...), -1 for (u - f)(...); band: the factor (z - pL) or (pH - z).
+        for (const auto& [edge, side] : {std::pair{l, 1.0}, std::pair{u, -1.0}})
+          for (const auto* band : {&d_.phi_lo[tau], &d_.phi_hi[tau]})
+            AddFormBandRow(form, tau, edge, side * (band == &d_.phi_lo[tau] ? 1.0 : -1.0), *band);
+      }
     }
   }
+
+  // One product row of a form's edge factor with a band factor; k is the sign of f * z in the product.
+  void AddFormBandRow(const DynamicsForm& form, int tau, double edge, double k, const std::vector<Interval>& ph) {
+    for (int i = 1; i <= na_; ++i) {
+      if (form[i - 1] == 0.0) continue;
+      row_.Add(w_col_[i][tau - window_.begin], k * form[i - 1]);
+      row_.Add(a_col(i), -k * (Interval(form[i - 1]) * ph[0]));
+      for (int j = 2; j <= n_alpha_; ++j) row_.Add(c_col_[i][j], -k * (Interval(form[i - 1]) * ph[j - 1]));
+    }
+    // -side * edge * (z - p) for band lo, i.e. the edge times the band factor.
+    row_.Add(z_col(tau), -k * edge);
+    for (int j = 2; j <= n_alpha_; ++j) row_.Add(alpha_col(j), k * (Interval(edge) * ph[j - 1]));
+    row_.AtLeast(-k * (Interval(edge) * ph[0]));
+  }
+
   // Envelopes of c_ij = a_i alpha_j and beta_jk = b_j gamma_k.
-  for (int i = 1; i <= na; ++i)
-    for (int j = 2; j <= n_alpha; ++j)
-      AddMcCormick(&lp, c_col[i][j], a_col(i), range(a_col(i)), alpha_col(j), range(alpha_col(j)));
-  for (int j = j0; j <= nb; ++j)
-    for (int k = 2; k <= n_gamma; ++k) {
-      const int b = out.beta_col[j - j0][0];
-      AddMcCormick(&lp, out.beta_col[j - j0][k - 1], b, range(b), gamma_col(k), range(gamma_col(k)));
-    }
-  // The assumption: p(alpha, .) increases over the data range, so it increases between grid points.
-  for (std::size_t m = 0; m + 1 < d.grid.size(); ++m) {
-    for (int j = 2; j <= n_alpha; ++j) row.Add(alpha_col(j), d.phi_grid[m + 1][j - 1] - d.phi_grid[m][j - 1]);
-    row.AtLeast(d.phi_grid[m][0] - d.phi_grid[m + 1][0]);
+  void AddEnvelopes() {
+    for (int i = 1; i <= na_; ++i)
+      for (int j = 2; j <= n_alpha_; ++j)
+        AddMcCormick(&out_.lp, c_col_[i][j], a_col(i), range(a_col(i)), alpha_col(j), range(alpha_col(j)));
+    for (int j = j0_; j <= nb_; ++j)
+      for (int k = 2; k <= n_gamma_; ++k) {
+        const int b = out_.beta_col[j - j0_][0];
+        AddMcCormick(&out_.lp, out_.beta_col[j - j0_][k - 1], b, range(b), gamma_col(k), range(gamma_col(k)));
+      }
   }
-  return out;
+
+  // The assumption: p(alpha, .) increases over the data range, so it increases between grid points.
+  void AddMonotonicityRows() {
+    for (std::size_t m = 0; m + 1 < d_.grid.size(); ++m) {
+      for (int j = 2; j <= n_alpha_; ++j) row_.Add(alpha_col(j), d_.phi_grid[m + 1][j - 1] - d_.phi_grid[m][j - 1]);
+      row_.AtLeast(d_.phi_grid[m][0] - d_.phi_grid[m + 1][0]);
+    }
+  }
+
+  const LiftedData& d_;
+  const dss::ParameterLayout& lay_;
+  const ParamBox& box_;
+  const Window window_;
+  const LiftedForm form_;
+  const int na_, n_alpha_, n_gamma_, j0_, nb_, t_first_;
+  LiftedLp out_;
+  RowBuilder row_;
+  std::vector<std::vector<int>> c_col_;  // [i][j]: c_ij = a_i alpha_j
+  std::vector<std::vector<int>> w_col_;  // [i][tau - window.begin]: w = a_i z_tau (-1: unused)
+};
+
+}  // namespace
+
+LiftedLp BuildLiftedLp(const LiftedData& d, const ParamBox& box, Window window, LiftedForm form) {
+  return LiftedLpBuilder(d, box, window, form).Build();
 }
 
 }  // namespace hw::exact
