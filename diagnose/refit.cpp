@@ -167,6 +167,8 @@ bool HasStateBlock(const AugmentedModel& m) {
   return false;
 }
 
+}  // namespace
+
 // Exact least squares, for fixed poles, of the numerator, the offset and the initial state:
 // y ~ sum_j b_j f_{t-d-j} + c + sum_i s_i h_i(t), with f = x / A(q) and h_i the free response of 1/A(q)
 // to z_{-i} = 1. Only for models that are linear in these numbers (input blocks, identity output map).
@@ -214,6 +216,8 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
   if (ninit > 0) m->initial_state.assign(th.data() + c, th.data() + c + ninit);
   return true;
 }
+
+namespace {
 
 // ARX poles at the model's delay plus a delay block's dead time, on the input as the model's input map
 // sees it; then the numerator, offset and initial state by least squares.
