@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <thread>
 
 #include <Eigen/Dense>
@@ -230,19 +231,31 @@ bool PredictsAlike(const Vec& a, const Vec& b, const Segment& agree, double scal
 // search) or lie scattered among others (each is skipped on its own).
 enum class TieRun { kContiguous, kScattered };
 
-// Among `values` of parameter `param` of the model's one block, the model that predicts `agree` exactly as
-// `model` does and scores lowest by `mse` (the data that judge it); `model` itself when none scores lower.
-AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, int param, const std::vector<double>& values,
-                             const Segment& agree, TieRun run, const std::function<double(const AugmentedModel&)>& mse) {
-  const Vec pred = model.simulate(c.ident.u);
+// How a tie search moves the rest of the model with the varied number: not at all (a relay threshold, a
+// stiction band), or the numerator, offset and initial state re-solved on the data where predictions must
+// agree (a quantizer step, which scales the quantized input).
+enum class TieResolve { kNone, kNumerator };
+
+// Among `points` (values of the parameters `params` of the model's one block), the model that predicts
+// `agree` exactly as `model` does and scores lowest by `mse` (the data that judge it); `model` itself
+// when none scores lower.
+AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, const std::vector<int>& params,
+                             const std::vector<Vec>& points, const Segment& agree, TieRun run,
+                             const std::function<double(const AugmentedModel&)>& mse, TieResolve resolve = TieResolve::kNone) {
+  const auto resolved = [&](AugmentedModel* t) {
+    return resolve == TieResolve::kNone || SolveNumerator(t, agree, c.o.refit);
+  };
+  AugmentedModel reference = model;
+  if (!resolved(&reference)) return model;
+  const Vec pred = reference.simulate(c.ident.u);
   const double scale = std::sqrt(SumSquaredError(model, agree) / std::max<double>(agree.Count(), 1));
   AugmentedModel best = model;
   double best_mse = mse(model);
-  for (double value : values) {
+  for (const Vec& point : points) {
     AugmentedModel t = model;
-    t.blocks[0].params[param] = value;
+    for (std::size_t i = 0; i < params.size(); ++i) t.blocks[0].params[params[i]] = point[i];
     std::string err;
-    if (!t.blocks[0].IsValid(&err)) continue;
+    if (!t.blocks[0].IsValid(&err) || !resolved(&t)) continue;
     if (!PredictsAlike(t.simulate(c.ident.u), pred, agree, scale)) {
       if (run == TieRun::kContiguous) break;
       continue;
@@ -251,6 +264,13 @@ AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, int 
     if (m < best_mse) best_mse = m, best = t;
   }
   return best;
+}
+
+// One parameter's values as points of a tie search.
+std::vector<Vec> AsPoints(const Vec& values) {
+  std::vector<Vec> points;
+  for (double v : values) points.push_back({v});
+  return points;
 }
 
 // A relay's threshold is seen only through which input moves cross it: on an input of few levels (steps,
@@ -266,11 +286,7 @@ AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, int 
 // of the run switched on moves in the tail that the device ignores, and the tail showed the relay
 // worse than none): when the tail does not confirm the relay, every threshold that predicts the
 // fitting part exactly as the fitted one is equally supported, and the tail judges the best of them.
-// `model` is varied; `agree` (a part of the identification recording) is where predictions must agree;
-// `mse` scores a candidate on the data that judge it.
-bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, const Segment& agree,
-                                 const std::function<double(const AugmentedModel&)>& mse) {
-  if (model->blocks.size() != 1 || model->blocks[0].effect != Effect::kHysteresis) return false;
+Vec RelayThresholdsToTry(const Context& c) {
   std::vector<double> mags;
   for (const Vec* u : {&c.ident.u, &c.valid.u})
     for (double v : *u) mags.push_back(std::abs(v));
@@ -279,22 +295,67 @@ bool BestRelayThresholdAmongTies(const Context& c, AugmentedModel* model, const 
   std::vector<double> values;
   const std::size_t stride = std::max<std::size_t>(1, mags.size() / 400);
   for (std::size_t k = 0; k + 1 < mags.size(); k += stride) values.push_back(0.5 * (mags[k] + mags[k + 1]));
-  AugmentedModel best = BestAmongTies(c, *model, 0, values, agree, TieRun::kScattered, mse);
-  if (best.blocks[0].params[0] == model->blocks[0].params[0]) return false;
+  return values;
+}
+
+// An input quantizer's step is seen only through the level each input sample rounds to: with its grid
+// offset held, every step that rounds the samples alike scales the quantized input by the same factor,
+// which the re-solved numerator undoes (and the output offset the shift), so the prediction is the same.
+// The identification recording cannot tell where in that run the step lies; validation, whose input
+// reaches other values, can (retired seed 1 000 114, steps: the steps from 0.1497 to 0.1500 fit the
+// identification recording equally well, and validation's error under some of them is 0.37x that under
+// the fit's 0.1498).
+// Its grid offset moves the levels alike (the output offset absorbs the shift), so the two are searched
+// together: steps 0.03 % apart within 3 % of the fitted one (a quantizer with R/q levels needs q to within
+// q/2R), grid offsets a tenth of a step apart over one step.
+constexpr int kQuantizerTieSteps = 100, kQuantizerTieOffsets = 5;
+std::vector<Vec> QuantizerStepsAndOffsetsToTry(double step, double offset) {
+  std::vector<Vec> points;
+  for (int k = -kQuantizerTieSteps; k <= kQuantizerTieSteps; ++k)
+    for (int j = -kQuantizerTieOffsets; j <= kQuantizerTieOffsets; ++j)
+      if (k != 0 || j != 0) points.push_back({step * (1.0 + 0.0003 * k), offset + step * j / (2.0 * kQuantizerTieOffsets)});
+  return points;
+}
+
+// The numbers of the model's one block that a tie search varies, the points it tries, and how the model
+// follows them; none for blocks without such numbers.
+struct TieSearch {
+  std::vector<int> params;
+  std::vector<Vec> points;
+  TieResolve resolve = TieResolve::kNone;
+};
+std::optional<TieSearch> TieSearchFor(const Context& c, const AugmentedModel& m) {
+  if (m.blocks.size() != 1) return std::nullopt;
+  const EffectBlock& b = m.blocks[0];
+  if (b.effect == Effect::kHysteresis) return TieSearch{{0}, AsPoints(RelayThresholdsToTry(c)), TieResolve::kNone};
+  if (b.effect == Effect::kQuantization && b.location == Location::kInput)
+    return TieSearch{{0, 1}, QuantizerStepsAndOffsetsToTry(b.params[0], b.params[1]), TieResolve::kNumerator};
+  return std::nullopt;
+}
+
+// `model` is varied; `agree` (a part of the identification recording) is where predictions must agree;
+// `mse` scores a candidate on the data that judge it. Returns whether the model changed.
+bool BestTiedValue(const Context& c, AugmentedModel* model, const Segment& agree,
+                   const std::function<double(const AugmentedModel&)>& mse) {
+  const std::optional<TieSearch> search = TieSearchFor(c, *model);
+  if (!search) return false;
+  AugmentedModel best = BestAmongTies(c, *model, search->params, search->points, agree, TieRun::kScattered, mse,
+                                      search->resolve);
+  if (best.blocks[0].params == model->blocks[0].params) return false;
   *model = best;
   return true;
 }
 
-void ChooseRelayThresholdAmongTies(const Context& c, const Reference& ref, Finding* f) {
+void ChooseTiedValueAmongIdentificationTies(const Context& c, const Reference& ref, Finding* f) {
   const auto valid_mse = [&](const AugmentedModel& m) { return Mse(c.ValidationResidual(m), c.skip, c.nv); };
-  if (!BestRelayThresholdAmongTies(c, &f->model, c.full, valid_mse)) return;
+  if (!BestTiedValue(c, &f->model, c.full, valid_mse)) return;
   f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(f->model), c.skip, c.nv, f->extra_parameters,
                             c.o.validation_z);
 }
 
-void ChooseRelayThresholdAmongFittingTies(const Context& c, const Reference& ref, Finding* f) {
+void ChooseTiedValueAmongFittingTies(const Context& c, const Reference& ref, Finding* f) {
   const auto tail_mse = [&](const AugmentedModel& m) { return Mse(c.IdentResidual(m), c.nfit, c.n); };
-  if (!BestRelayThresholdAmongTies(c, &f->fitted, c.fit, tail_mse)) return;
+  if (!BestTiedValue(c, &f->fitted, c.fit, tail_mse)) return;
   f->blocks = f->fitted.blocks;
   f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(f->fitted), c.nfit, c.n, f->extra_parameters,
                          c.o.significance_z);
@@ -331,7 +392,7 @@ void ChooseStaticBandAmongTies(const Context& c, const Reference& ref, Finding* 
   if (m.blocks.size() != 1 || m.blocks[0].effect != Effect::kStiction || HasStickSlipJump(m.blocks[0])) return;
   const auto valid_mse = [&](const AugmentedModel& t) { return Mse(c.ValidationResidual(t), c.skip, c.nv); };
   const AugmentedModel best =
-      BestAmongTies(c, m, 0, StaticBandsAbove(c, m.blocks[0].params[1]), c.full, TieRun::kContiguous, valid_mse);
+      BestAmongTies(c, m, {0}, AsPoints(StaticBandsAbove(c, m.blocks[0].params[1])), c.full, TieRun::kContiguous, valid_mse);
   if (!HasStickSlipJump(best.blocks[0])) return;
   if (!c.Compare(c.ValidationResidual(m), c.ValidationResidual(best), c.skip, c.nv, 1, c.o.validation_z).significant)
     return;
@@ -421,8 +482,8 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
                            c.o.validation_z);
   if (f.holdout.significant != f.validation.significant) ReconcileFits(c, ref, effect, location, chosen, &f);
-  if (!f.holdout.significant) ChooseRelayThresholdAmongFittingTies(c, ref, &f);
-  if (f.holdout.significant && !f.validation.significant) ChooseRelayThresholdAmongTies(c, ref, &f);
+  if (!f.holdout.significant) ChooseTiedValueAmongFittingTies(c, ref, &f);
+  if (f.holdout.significant && !f.validation.significant) ChooseTiedValueAmongIdentificationTies(c, ref, &f);
   ChooseStaticBandAmongTies(c, ref, &f);
   bool meaningful = true;
   for (const auto& b : f.blocks)

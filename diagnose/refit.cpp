@@ -167,6 +167,8 @@ bool HasStateBlock(const AugmentedModel& m) {
   return false;
 }
 
+}  // namespace
+
 // Exact least squares, for fixed poles, of the numerator, the offset and the initial state:
 // y ~ sum_j b_j f_{t-d-j} + c + sum_i s_i h_i(t), with f = x / A(q) and h_i the free response of 1/A(q)
 // to z_{-i} = 1. Only for models that are linear in these numbers (input blocks, identity output map).
@@ -214,6 +216,8 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
   if (ninit > 0) m->initial_state.assign(th.data() + c, th.data() + c + ninit);
   return true;
 }
+
+namespace {
 
 // ARX poles at the model's delay plus a delay block's dead time, on the input as the model's input map
 // sees it; then the numerator, offset and initial state by least squares.
@@ -501,10 +505,12 @@ bool SearchOffsetUnderOutputQuantizer(AugmentedModel* m, const Segment& s, const
 // The other numbers under an output quantizer (linear block, maps, offset, initial state) see a cost
 // that is piecewise constant, so LM from the nominal's values barely moves them, and a quantizer with the
 // right step then mispredicts new data. They are refitted by continuation: LM with the rounding smoothed
-// over a quarter and then a tenth of a step, then the exact staircase; kept when the exact cost drops.
+// over half a step, then a quarter, a tenth and a twentieth, then the exact staircase; kept when the exact
+// cost drops. Starting at a quarter step left the nominal part in a poorer optimum (retired seed
+// 1 000 302: validation MSE 1.12x the baseline's, where the true model has a fourteenth of the fit's error).
 void RefitUnderSmoothedOutputQuantizer(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
   AugmentedModel t = *m;
-  for (double width : {0.25, 0.1}) {
+  for (double width : {0.5, 0.25, 0.1, 0.05}) {
     t.output_quantizer_smoothing = width;
     Lm(&t, Packing::For(t, o), s, o.lm);
   }

@@ -79,6 +79,10 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
 // fixed models on a validation recording that does not start from rest. No-op when the linear block
 // has no poles or when `options.estimate_initial_state` is false.
 void EstimateInitialState(AugmentedModel* model, const Segment& data, const RefitOptions& options);
+// Exact least squares, for fixed poles, of the numerator, the output offset and the initial state.
+// Returns false (model unchanged) for models not linear in these numbers: a non-identity output map,
+// an output or a state block.
+bool SolveNumerator(AugmentedModel* model, const Segment& data, const RefitOptions& options);
 
 // a_1..a_n of A(q) = prod (1 - r q^-1) over the roots r (complex roots in conjugate pairs).
 std::vector<double> DenominatorFromRoots(const std::vector<std::complex<double>>& roots);
