@@ -69,14 +69,11 @@ void ProbeSlab(const ProbeContext& c, ex::ParamBox box, const ex::Objective& obj
 }
 
 
-// D's known extent per entry: the inner hull's range over its certified points (the box's own range for a form).
-ex::ParamBox InnerExtent(const ex::LiftedData& lifted, const ex::InnerHull& hull, const ex::ParamBox& box) {
+// D's known extent per entry: the inner hull's range (the box's own range for a form or an entry without one).
+ex::ParamBox InnerExtent(const ex::InnerHull& hull, const ex::ParamBox& box) {
   ex::ParamBox extent = box;
-  for (int k = 0; k < lifted.layout.count(); ++k) {
-    double lo = box[k].hi, hi = box[k].lo;
-    for (const auto& pt : hull.points) lo = std::min(lo, pt.theta[k]), hi = std::max(hi, pt.theta[k]);
-    if (lo <= hi) extent[k] = ex::Interval(lo, hi);
-  }
+  for (std::size_t k = 0; k < hull.ranges.size() && k < box.size(); ++k)
+    if (hull.ranges[k]) extent[k] = ex::Interval(hull.ranges[k]->first, hull.ranges[k]->second);
   return extent;
 }
 
@@ -198,7 +195,7 @@ int main(int argc, char** argv) {
   if (search_budget > 0) {
     ex::EndpointSplit split;
     if (!ex::ParseEndpointSplit(split_name, &split)) throw std::invalid_argument("unknown --split " + split_name);
-    ProbeSearch(context, box, objective, extreme[p], InnerExtent(lifted, hull, box), search_budget, split);
+    ProbeSearch(context, box, objective, extreme[p], InnerExtent(hull, box), search_budget, split);
     return 0;
   }
   if (!slices.empty()) {

@@ -25,6 +25,11 @@ int WidestAgainst(const std::vector<int>& entries, const ParamBox& box, const Pa
   return best;
 }
 
+// Whether layout entry p is one of the a_i.
+bool IsDynamicsCoefficient(const LiftedData& data, int p) {
+  return p >= data.layout.a_begin && p < data.layout.a_begin + data.structure.na;
+}
+
 // The dynamics' entries: the forms first (on a tie the cut across D's strip removes more), then the a_i.
 std::vector<int> DynamicsEntries(const LiftedData& data, std::size_t box_size) {
   const auto& lay = data.layout;
@@ -44,7 +49,7 @@ std::vector<int> FamilyEntries(const LiftedData& data, int p, EndpointSplit spli
   auto add = [&](int begin, int count) {
     for (int k = begin; k < begin + count; ++k) entries.push_back(k);
   };
-  if (in(p, lay.a_begin, data.structure.na) && split == EndpointSplit::kDynamicsGamma) add(lay.gamma_begin, lay.num_gamma);
+  if (split == EndpointSplit::kDynamicsGamma && IsDynamicsCoefficient(data, p)) add(lay.gamma_begin, lay.num_gamma);
   if (split == EndpointSplit::kFamily && in(p, lay.gamma_begin, lay.num_gamma)) add(lay.gamma_begin, lay.num_gamma);
   if (split == EndpointSplit::kFamily && (in(p, lay.alpha_begin, lay.num_alpha) || in(p, lay.b_begin, nb))) {
     add(lay.alpha_begin, lay.num_alpha);
@@ -61,8 +66,7 @@ int SplitParameter(const LiftedData& data, const ParamBox& box, const ParamBox& 
 
 int SplitEntry(const LiftedData& data, const ParamBox& box, const ParamBox& start, int p, EndpointSplit split,
                const ParamBox* scale) {
-  const bool dynamics_gamma = split == EndpointSplit::kDynamicsGamma && p >= data.layout.a_begin &&
-                              p < data.layout.a_begin + data.structure.na;
+  const bool dynamics_gamma = split == EndpointSplit::kDynamicsGamma && IsDynamicsCoefficient(data, p);
   if (split != EndpointSplit::kFamily && !dynamics_gamma) return SplitParameter(data, box, start);
   const ParamBox& reference = scale && scale->size() == box.size() ? *scale : start;
   return WidestAgainst(FamilyEntries(data, p, split, std::min(box.size(), start.size())), box, reference, start);
@@ -242,8 +246,7 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
     }
     if (target && box.bound >= sign * *target - target_gap) break;  // within the target of a point of D
     if (out.lps >= options.lp_budget) break;
-    const bool is_dynamics =
-        (p >= data.layout.a_begin && p < data.layout.a_begin + data.structure.na) || p >= data.layout.count();
+    const bool is_dynamics = IsDynamicsCoefficient(data, p) || p >= data.layout.count();
     const bool cut_objective = options.split == EndpointSplit::kAlternate && !is_dynamics &&
                                box.objective_splits <= box.dynamics_splits;
     const int k = cut_objective ? p : SplitEntry(data, box.box, start, p, options.split, scale);
