@@ -9,13 +9,14 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "core/cerone_example.hpp"
 #include "dss/hw_outer_set.hpp"
 #include "exact/box_evaluation.hpp"
 #include "exact/branch_and_bound.hpp"
-#include "exact/dynamics_forms.hpp"
+#include "exact/parameter_forms.hpp"
 #include "exact/inner_hull.hpp"
 #include "exact/membership.hpp"
 #include "exact/lifted_lp.hpp"
@@ -115,6 +116,35 @@ void ProbeSlices(const ProbeContext& c, const ex::ParamBox& box, const ex::Objec
                *e.bound, m.slack);
   }
 }
+// Gain and shape forms from the inner hull's points (as a run with them would make), appended to the data's
+// forms; the box gets their ranges bounded by one LP per end (a run bounds them in the forms' sweep).
+void AddInputForms(ex::LiftedData& lifted, const ex::InnerHull& hull, const std::vector<std::string>& blocks,
+                   ex::ParamBox& box, const ex::BoxEvaluationOptions& options, ex::LpSolver& solver,
+                   ex::GammaRatio ratio) {
+  ex::FormOptions fo;
+  for (const auto& b : blocks) {
+    if (b == "gain") fo.gain = true;
+    else if (b == "shape") fo.shape = true;
+    else throw std::invalid_argument("--add-forms: gain or shape, not " + b);
+  }
+  std::vector<std::vector<double>> points;
+  for (const auto& pt : hull.points) points.push_back(pt.theta);
+  box = ex::WithFormRanges(lifted, box);
+  for (const auto& f : ex::ThinDirections(lifted, points, fo)) {
+    if (f.block == ex::FormBlock::kDynamics) continue;
+    lifted.forms.push_back(f);
+    box.push_back(ex::FormRange(lifted, f, box));
+    const int k = static_cast<int>(box.size()) - 1;
+    for (bool up : {false, true}) {
+      const auto e = ex::BoundObjective(lifted, box, ex::Objective{k, up}, options, solver, {}, ratio);
+      if (e.bound && up) box[k].hi = std::min(box[k].hi, *e.bound);
+      if (e.bound && !up) box[k].lo = std::max(box[k].lo, *e.bound);
+    }
+    fmt::print("{} form [{}]: range [{:.7g}, {:.7g}]\n", ex::ToString(f.block), fmt::join(f.coef, ", "), box[k].lo,
+               box[k].hi);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -146,6 +176,11 @@ int main(int argc, char** argv) {
   std::vector<std::string> pinned;
   app.add_option("--pin", pinned, "entries fixed at the inner extreme's values (to 1e-7 relative) before probing")
       ->delimiter(',');
+  std::vector<std::string> add_forms;
+  app.add_option("--add-forms", add_forms,
+                 "gain,shape: forms over the b_j / the gammas from the inner hull's points, their ranges bounded by "
+                 "two LPs each on the box before probing")
+      ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   std::ifstream in(result_path);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -154,7 +189,8 @@ int main(int argc, char** argv) {
                                                  real.at("snr_db").get<double>());
   hw::dss::HwData data{ex_data.u, ex_data.y, std::vector<double>(ex_data.y.size(), ex_data.noise_bound), "probe"};
   auto lifted = ex::MakeLiftedData(hw::dss::CeroneExampleStructure(), data);
-  lifted.dynamics_forms = ex::FormsFromJson(j.at("stage2").at("dynamics_forms"));
+  const auto& stage2 = j.at("stage2");
+  lifted.forms = ex::FormsFromJson(stage2.contains("forms") ? stage2.at("forms") : stage2.at("dynamics_forms"));
   ex::ParamBox box;
   if (start_box)
     for (const auto& iv : j.at("start_box")) box.emplace_back(iv.at(0).get<double>(), iv.at(1).get<double>());
@@ -178,10 +214,11 @@ int main(int argc, char** argv) {
     if (k >= lifted.layout.count()) throw std::invalid_argument("--pin: unknown parameter " + name);
     box[k] = ex::Interval(extreme[k] - 1e-7 * std::abs(extreme[k]), extreme[k] + 1e-7 * std::abs(extreme[k]));
   }
+  ex::BoxEvaluationOptions options;
+  if (!add_forms.empty()) AddInputForms(lifted, hull, add_forms, box, options, *solver, ratio);
   box = ex::WithFormRanges(lifted, box);
   ex::PropagateForms(lifted, box);
   const ex::Objective objective{p, maximise};
-  ex::BoxEvaluationOptions options;
   auto bound_on = [&](const ex::ParamBox& b) {
     const auto e = ex::BoundObjective(lifted, b, objective, options, *solver, {}, ratio);
     return std::pair{e.bound ? *e.bound : NAN, e.lps};
@@ -211,7 +248,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   std::vector<double> at = extreme;
-  for (const auto& f : lifted.dynamics_forms) at.push_back(ex::FormValue(lifted, f, extreme));
+  for (const auto& f : lifted.forms) at.push_back(ex::FormValue(lifted, f, extreme));
   auto narrowed = [&](ex::ParamBox b, int k) {
     const double half = 0.5 * share * (b[k].hi - b[k].lo);
     const double c = std::clamp(at[k], b[k].lo + half, b[k].hi - half);

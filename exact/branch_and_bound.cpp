@@ -30,11 +30,12 @@ bool IsDynamicsCoefficient(const LiftedData& data, int p) {
   return p >= data.layout.a_begin && p < data.layout.a_begin + data.structure.na;
 }
 
-// The dynamics' entries: the forms first (on a tie the cut across D's strip removes more), then the a_i.
+// The dynamics' entries: the dynamics forms first (on a tie the cut across D's strip removes more), then the a_i.
 std::vector<int> DynamicsEntries(const LiftedData& data, std::size_t box_size) {
   const auto& lay = data.layout;
   std::vector<int> entries;
-  for (int k = lay.count(); k < static_cast<int>(box_size); ++k) entries.push_back(k);
+  for (int k = lay.count(); k < static_cast<int>(box_size); ++k)
+    if (IsDynamicsEntry(data, k)) entries.push_back(k);
   for (int i = 0; i < data.structure.na; ++i) entries.push_back(lay.a_begin + i);
   return entries;
 }
@@ -246,7 +247,7 @@ ObjectiveSearchResult SearchObjective(const LiftedData& data, const ParamBox& st
     }
     if (target && box.bound >= sign * *target - target_gap) break;  // within the target of a point of D
     if (out.lps >= options.lp_budget) break;
-    const bool is_dynamics = IsDynamicsCoefficient(data, p) || p >= data.layout.count();
+    const bool is_dynamics = IsDynamicsEntry(data, p);
     const bool cut_objective = options.split == EndpointSplit::kAlternate && !is_dynamics &&
                                box.objective_splits <= box.dynamics_splits;
     const int k = cut_objective ? p : SplitEntry(data, box.box, start, p, options.split, scale);

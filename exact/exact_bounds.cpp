@@ -141,7 +141,7 @@ using InnerRanges = std::vector<std::optional<std::pair<double, double>>>;
 // The inner hull's ranges for every entry of a box with forms: the parameters', then each form's over the points.
 InnerRanges InnerRangesWithForms(const LiftedData& data, const InnerHull& inner) {
   InnerRanges ranges = inner.ranges;
-  for (const auto& form : data.dynamics_forms) {
+  for (const auto& form : data.forms) {
     std::optional<std::pair<double, double>> r;
     for (const auto& p : inner.points) {
       const double v = FormValue(data, form, p.theta);
@@ -200,7 +200,7 @@ void BoundSweep(const LiftedData& data, const ParamBox& start, const std::vector
       std::optional<int> budget;
       if (closing) budget = closing_budget;
       else if (GammaWithoutDenominator(data, start, k)) budget = kUnsignedGammaBudget;
-      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.dynamics_forms, budget, scale));
+      specs.push_back(ObjectiveJobSpec(start, boxes, objectives.back(), target, gap, data.forms, budget, scale));
     }
   const auto answers = runner.Run(specs, on_done);
   for (std::size_t o = 0; o < objectives.size(); ++o) {
@@ -345,7 +345,7 @@ nlohmann::json ExactBoundsSummary::to_json() const {
             {"jobs_from_cache", jobs_from_cache}, {"lp_rows", lp_rows}, {"lp_cols", lp_cols},
             {"lp_nonzeros", lp_nonzeros}, {"prune_seconds", prune_seconds}, {"inner_seconds", inner_seconds},
             {"bound_seconds", bound_seconds}, {"wall_seconds", wall_seconds}, {"inner_points", inner_points},
-            {"executor", executor}, {"lp_solver", lp_solver}, {"dynamics_forms", FormsToJson(dynamics_forms)}}}};
+            {"executor", executor}, {"lp_solver", lp_solver}, {"forms", FormsToJson(forms)}}}};
 }
 
 ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const dss::HwStructure& structure,
@@ -392,6 +392,8 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
                          {"dynamics_forms", options.dynamics_forms ? options.forms.thin_share : 0.0},
                          {"cheap_windows", {ev.cheap_window, ev.cheap_windows}},
                          {"lp_tolerances", {ev.lp.primal_tolerance, ev.lp.dual_tolerance, ev.lp.time_limit_seconds}}};
+  if (options.forms.gain) meta["gain_forms"] = true;
+  if (options.forms.shape) meta["shape_forms"] = true;
   const std::string key = JobKey(meta.dump() + std::to_string(lifted.num_samples));
   const dss::RunCache cache(options.run_dir, "exact-" + key, meta);
   JobRunner runner(*executor, cache, fn, s);
@@ -437,15 +439,15 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     for (int k = 0; k < lay.count(); ++k) s.intervals[k].inner = inner->ranges[k];
   }
 
-  // Forms across D's thin directions, from the inner hull's points (exact/dynamics_forms.hpp).
+  // Forms across D's thin directions, from the inner hull's points (exact/parameter_forms.hpp).
   LiftedData with_forms = lifted;
   if (inner && options.dynamics_forms) {
     std::vector<std::vector<double>> points;
     for (const auto& p : inner->points) points.push_back(p.theta);
-    with_forms.dynamics_forms = ThinDirections(lifted, points, options.forms);
+    with_forms.forms = ThinDirections(lifted, points, options.forms);
   }
-  s.dynamics_forms = with_forms.dynamics_forms;
-  if (!with_forms.dynamics_forms.empty()) {  // the bounding LPs' shape, forms included
+  s.forms = with_forms.forms;
+  if (!with_forms.forms.empty()) {  // the bounding LPs' shape, forms included
     const LiftedLp shape =
         BuildLiftedLp(with_forms, WithFormRanges(with_forms, proven), WholeRecord(lifted), LiftedForm::kFeasibility);
     s.lp_rows = shape.lp.num_rows();
@@ -457,7 +459,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
 
   // 3. bound, in sweeps: each later sweep starts in the box the earlier ones proved.
   t = Clock::now();
-  std::vector<Interval> form_ranges(with_forms.dynamics_forms.size(), Interval(-INFINITY, INFINITY));
+  std::vector<Interval> form_ranges(with_forms.forms.size(), Interval(-INFINITY, INFINITY));
   // The forms' own ranges first (sweep 0): every endpoint's search then starts with D's strip already narrow,
   // instead of each one cutting it down on its own.
   // After the sweeps, a closing pass for the endpoints still short of their target (sweep options.sweeps + 1).

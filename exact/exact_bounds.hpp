@@ -47,9 +47,10 @@ struct ExactBoundsOptions {
   // Bounding sweeps at most; each after the first starts in the box the previous proved. Sweeps stop early once
   // every interval is within target_ratio times its inner hull.
   int sweeps = 4;
-  // Bound and halve forms across D's thin directions in (a_1..a_na) too (exact/dynamics_forms.hpp).
+  // Bound forms across D's thin directions too (exact/parameter_forms.hpp): over (a_1..a_na), halved beside the
+  // a_i, and, as `forms` asks, over the b_j and the gammas.
   bool dynamics_forms = true;
-  DynamicsFormOptions forms;
+  FormOptions forms;
   double target_ratio = 1.25;     // stop refining an endpoint once outer/inner width would be at most this
   // After the sweeps, the endpoints still short of the target get a closing pass with the LPs a sweep would have
   // given the others: up to this many times search.lp_budget each (1 = no closing pass).
@@ -113,7 +114,7 @@ struct ExactBoundsSummary {
   AssumptionCheck assumption;
   std::string executor;
   std::string lp_solver;       // the LP backend that ran (certificates do not depend on it)
-  std::vector<DynamicsForm> dynamics_forms;  // the forms the bounding sweeps used
+  std::vector<ParameterForm> forms;  // the forms the bounding sweeps used
   bool worker_rank = false;
   nlohmann::json to_json() const;
 };

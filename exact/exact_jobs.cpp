@@ -58,7 +58,7 @@ nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool c
 
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap,
-                                const std::vector<DynamicsForm>& forms, std::optional<int> lp_budget,
+                                const std::vector<ParameterForm>& forms, std::optional<int> lp_budget,
                                 const std::optional<ParamBox>& scale) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& b : boxes) list.push_back(BoxToJson(b));
@@ -107,7 +107,7 @@ sdp::JobFunction MakeExactJobFunction(const LiftedData& data, const ExactJobSett
     LiftedData with_forms;
     if (spec.contains("forms")) {
       with_forms = data;
-      with_forms.dynamics_forms = FormsFromJson(spec.at("forms"));
+      with_forms.forms = FormsFromJson(spec.at("forms"));
     }
     std::optional<ParamBox> scale;
     if (spec.contains("scale")) scale = BoxFromJson(spec.at("scale"));

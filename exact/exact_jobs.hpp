@@ -22,7 +22,7 @@ struct ExactJobSettings {
 nlohmann::json EmptinessJobSpec(const ParamBox& box, const LpBasis& warm, bool cheap_windows);
 nlohmann::json ObjectiveJobSpec(const ParamBox& start, const std::vector<ParamBox>& boxes, const Objective& objective,
                                 std::optional<double> target, double target_gap,
-                                const std::vector<DynamicsForm>& forms = {},
+                                const std::vector<ParameterForm>& forms = {},
                                 std::optional<int> lp_budget = std::nullopt,  // default: the settings' budget
                                 const std::optional<ParamBox>& scale = std::nullopt);  // see SearchObjective
 

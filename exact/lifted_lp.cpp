@@ -138,6 +138,7 @@ class LiftedLpBuilder {
     AddDynamicsBandProducts();
     AddFormBandProducts();
     AddEnvelopes();
+    AddInputFormEnvelopes();
     AddMonotonicityRows();
     return std::move(out_);
   }
@@ -160,10 +161,10 @@ class LiftedLpBuilder {
   void AddParameterColumns() {
     LpProblem& lp = out_.lp;
     out_.param_col.resize(lay_.count());
-    if (has_form_ranges() && box_.size() != lay_.count() + d_.dynamics_forms.size())
-      throw InputError("a box with form ranges needs one per dynamics form");
+    if (has_form_ranges() && box_.size() != lay_.count() + d_.forms.size())
+      throw InputError("a box with form ranges needs one per parameter form");
     for (int k = 0; k < lay_.count(); ++k) out_.param_col[k] = lp.AddColumn(box_[k].lo, box_[k].hi);
-    for (std::size_t f = 0; f < d_.dynamics_forms.size() && has_form_ranges(); ++f)
+    for (std::size_t f = 0; f < d_.forms.size() && has_form_ranges(); ++f)
       out_.param_col.push_back(lp.AddColumn(box_[lay_.count() + f].lo, box_[lay_.count() + f].hi));
   }
 
@@ -286,16 +287,24 @@ class LiftedLpBuilder {
     }
   }
 
-  // The forms f = sum_i c_i a_i of the box: (f - l)(z - pL) >= 0 and its three siblings, with f z_tau =
+  // f = sum_i c_i theta_i for form f (its column equals the combination of its block's columns).
+  void AddFormDefinition(std::size_t f) {
+    const ParameterForm& form = d_.forms[f];
+    const int first = BlockEntries(d_, form.block).first;
+    row_.Add(out_.param_col[lay_.count() + f], 1.0);
+    for (std::size_t i = 0; i < form.coef.size(); ++i)
+      if (form.coef[i] != 0.0) row_.Add(out_.param_col[first + i], -form.coef[i]);
+    row_.EqualTo(0.0);
+  }
+
+  // The dynamics forms f = sum_i c_i a_i of the box: (f - l)(z - pL) >= 0 and its three siblings, with f z_tau =
   // sum_i c_i w_{i,tau} and f p(alpha, .) = sum_i c_i (a_i phi_1 + sum_j c_ij phi_j); only where every w_{i,tau}
   // of the form exists (fewer rows stay a valid relaxation).
   void AddFormBandProducts() {
-    for (std::size_t f = 0; f < d_.dynamics_forms.size() && has_form_ranges(); ++f) {
-      const DynamicsForm& form = d_.dynamics_forms[f];
-      row_.Add(out_.param_col[lay_.count() + f], 1.0);
-      for (int i = 1; i <= na_; ++i)
-        if (form[i - 1] != 0.0) row_.Add(a_col(i), -form[i - 1]);
-      row_.EqualTo(0.0);
+    for (std::size_t f = 0; f < d_.forms.size() && has_form_ranges(); ++f) {
+      if (d_.forms[f].block != FormBlock::kDynamics) continue;
+      const std::vector<double>& form = d_.forms[f].coef;
+      AddFormDefinition(f);
       const double l = box_[lay_.count() + f].lo, u = box_[lay_.count() + f].hi;
       for (int tau = window_.begin; tau < window_.end; ++tau) {
         bool all = true;
@@ -310,7 +319,7 @@ class LiftedLpBuilder {
   }
 
   // One product row of a form's edge factor with a band factor; k is the sign of f * z in the product.
-  void AddFormBandRow(const DynamicsForm& form, int tau, double edge, double k, const std::vector<Interval>& ph) {
+  void AddFormBandRow(const std::vector<double>& form, int tau, double edge, double k, const std::vector<Interval>& ph) {
     for (int i = 1; i <= na_; ++i) {
       if (form[i - 1] == 0.0) continue;
       row_.Add(w_col_[i][tau - window_.begin], k * form[i - 1]);
@@ -333,6 +342,67 @@ class LiftedLpBuilder {
         const int b = out_.beta_col[j - j0_][0];
         AddMcCormick(&out_.lp, out_.beta_col[j - j0_][k - 1], b, range(b), gamma_col(k), range(gamma_col(k)));
       }
+  }
+
+  // A factor of beta_jk = b_j gamma_k's two sides: a parameter (one unit coefficient) or a gain or shape form.
+  struct InputFactor {
+    int col;
+    Interval range;
+    std::vector<double> coef;  // over the side's entries (b_j0..b_nb, or gamma_2..gamma_ng)
+  };
+
+  // The gain forms' and shape forms' definitions, and McCormick envelopes of every product of a gain-side factor
+  // (b_j or a gain form) with a shape-side factor (gamma_k or a shape form) that involves a form: the product
+  // sum_j sum_k d_j e_k beta_jk is linear in beta. (The products of b_j with gamma_k are beta's own envelopes.)
+  void AddInputFormEnvelopes() {
+    if (!has_form_ranges()) return;
+    std::vector<InputFactor> gain_side, shape_side;
+    const int n_b = nb_ - j0_ + 1, n_g = n_gamma_ - 1;
+    for (int j = 0; j < n_b; ++j) {
+      const int col = out_.beta_col[j][0];
+      gain_side.push_back({col, range(col), std::vector<double>(n_b, 0.0)});
+      gain_side.back().coef[j] = 1.0;
+    }
+    for (int k = 0; k < n_g; ++k) {
+      const int col = gamma_col(k + 2);
+      shape_side.push_back({col, range(col), std::vector<double>(n_g, 0.0)});
+      shape_side.back().coef[k] = 1.0;
+    }
+    const std::size_t parameters_gain = gain_side.size(), parameters_shape = shape_side.size();
+    for (std::size_t f = 0; f < d_.forms.size(); ++f) {
+      const FormBlock block = d_.forms[f].block;
+      if (block == FormBlock::kDynamics) continue;
+      AddFormDefinition(f);
+      const int col = out_.param_col[lay_.count() + f];
+      (block == FormBlock::kGain ? gain_side : shape_side).push_back({col, range(col), d_.forms[f].coef});
+    }
+    for (std::size_t g = 0; g < gain_side.size(); ++g)
+      for (std::size_t h = 0; h < shape_side.size(); ++h) {
+        if (g < parameters_gain && h < parameters_shape) continue;
+        std::vector<std::pair<int, double>> product;
+        for (int j = 0; j < n_b; ++j)
+          for (int k = 0; k < n_g; ++k) {
+            const double c = gain_side[g].coef[j] * shape_side[h].coef[k];
+            if (c != 0.0) product.emplace_back(out_.beta_col[j][k + 1], c);
+          }
+        AddProductEnvelope(product, gain_side[g].col, gain_side[g].range, shape_side[h].col, shape_side[h].range);
+      }
+  }
+
+  // Four McCormick rows of x * y = sum of coefficient * column over x in X, y in Y (the coefficients are products
+  // of form coefficients rounded to 2^-20, exact in double).
+  void AddProductEnvelope(const std::vector<std::pair<int, double>>& product, int x, Interval X, int y, Interval Y) {
+    auto add_product = [&] {
+      for (const auto& [col, c] : product) row_.Add(col, c);
+    };
+    add_product();  // (x - xl)(y - yl) >= 0
+    row_.Add(x, -Y.lo).Add(y, -X.lo).AtLeast(-(Interval(X.lo) * Y.lo));
+    add_product();  // (xu - x)(yu - y) >= 0
+    row_.Add(x, -Y.hi).Add(y, -X.hi).AtLeast(-(Interval(X.hi) * Y.hi));
+    add_product();  // (x - xl)(yu - y) >= 0
+    row_.Add(x, -Y.hi).Add(y, -X.lo).AtMost(-(Interval(X.lo) * Y.hi));
+    add_product();  // (xu - x)(y - yl) >= 0
+    row_.Add(x, -Y.lo).Add(y, -X.hi).AtMost(-(Interval(X.hi) * Y.lo));
   }
 
   // The assumption: p(alpha, .) increases over the data range, so it increases between grid points.

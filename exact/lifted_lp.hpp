@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "dss/hw_outer_set.hpp"
-#include "exact/dynamics_forms.hpp"
+#include "exact/parameter_forms.hpp"
 #include "exact/interval.hpp"
 #include "exact/lp_problem.hpp"
 
@@ -38,14 +38,14 @@ struct LiftedData {
   std::vector<std::vector<Interval>> psi;            // [t][k]: psi_k(u_t)
   std::vector<std::vector<Interval>> phi_grid;       // [m][j]: phi_j at the monotonicity grid's points
   std::vector<double> grid;                          // the grid over [min L_t, max H_t]
-  std::vector<DynamicsForm> dynamics_forms;          // extra factors of the products (exact/dynamics_forms.hpp)
+  std::vector<ParameterForm> forms;                  // extra factors of the products (exact/parameter_forms.hpp)
   int first_lag() const { return structure.strictly_proper ? 1 : 0; }
 };
 // Checks the structure and data (throws hw::InputError with the sample's place for a non-finite value).
 LiftedData MakeLiftedData(const dss::HwStructure& structure, const dss::HwData& data, int grid_points = 64);
 
 // A box of the parameters in the layout's order [gamma_2.., alpha_2.., a_1..a_na, b_j0..b_nb], then (optional)
-// the ranges of data.dynamics_forms (exact/dynamics_forms.hpp).
+// the ranges of data.forms (exact/parameter_forms.hpp).
 
 struct Window {
   int begin = 0, end = 0;  // samples [begin, end)

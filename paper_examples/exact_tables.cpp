@@ -6,12 +6,14 @@
 //
 //   exact_tables --tables paper_examples/results/cerone_n23_snr31_delta3/tables.json --out DIR [--threads 2]
 //   exact_tables --summarise DIR1 DIR2 ... --summary-out FILE.md   (one table over earlier runs)
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_write.hpp"
@@ -109,6 +111,14 @@ int OrderOfStartBox(const std::string& tables, const exact::ParamBox& start_box)
   return 0;
 }
 
+// Where a run's start box came from: a committed D^ss(2) run of the same record, or of another record (a held-out
+// seed or another length: an assumed prior box for this one).
+std::string StartBoxLabel(int order, bool proven_for_this_record) {
+  if (order == 0) return "no committed D^ss(2) run matches";
+  return proven_for_this_record ? fmt::format("D^ss(2) at δ = {}", order)
+                                : fmt::format("D^ss(2) at δ = {} of another record (an assumed prior box)", order);
+}
+
 // One table over several runs of this program (DIR/exact.json each; run from the repository root, where the
 // runs' stage-1 paths are relative to): per parameter and realisation, outer/inner
 // and the exact interval's width against the paper's Table I and against D^ss(2); then each run's counts.
@@ -164,7 +174,7 @@ std::string Summary(const std::vector<std::string>& dirs) {
     const auto& s2 = r.j.at("stage2");
     md += fmt::format("| [{}]({}/exact_table.md) | {} | {:.0f} s on {} | {} ({}) | {}, {} | {} |\n",
                       realisation(r), r.dir.substr(r.dir.find_last_of('/') + 1),
-                      r.order ? fmt::format("D^ss(2) at δ = {}", r.order) : std::string("no committed D^ss(2) run matches"),
+                      StartBoxLabel(r.order, r.j.at("stage1").value("start_box_proven_for_this_record", true)),
                       s2.at("wall_seconds").get<double>(), s2.at("executor").get<std::string>(), s2.at("lps").get<int>(),
                       s2.at("lp_failures").get<int>(), s2.at("prune_levels").get<int>(), s2.at("boxes_pruned").get<int>(),
                       r.j.at("assumption").at("holds").get<bool>() ? "holds" : "not shown");
@@ -225,6 +235,16 @@ int main(int argc, char** argv) {
         return exact::ParseGammaRatio(text, &r) ? std::string() : "expected largest, rotate or pooled, not " + text;
       });
   app.add_option("--parameters", parameters, "intervals to compute (default: all), e.g. gamma2,gamma3")->delimiter(',');
+  std::vector<std::string> form_blocks;
+  if (exact::FormOptions{}.gain) form_blocks.push_back("gain");
+  if (exact::FormOptions{}.shape) form_blocks.push_back("shape");
+  if (form_blocks.empty()) form_blocks.push_back("none");
+  app.add_option("--input-forms", form_blocks,
+                 "forms across D's thin directions over these blocks besides the dynamics: gain (the b_j), shape (the "
+                 "gammas) or none")
+      ->capture_default_str()
+      ->delimiter(',')
+      ->check(CLI::IsMember({"gain", "shape", "none"}));
   CLI11_PARSE(app, argc, argv);
   try {
     if (!summarise.empty()) {
@@ -258,6 +278,8 @@ int main(int argc, char** argv) {
     options.short_endpoint_budget_cap = short_cap;
     options.target_ratio = target_ratio;
     options.lp_solver = lp_solver;
+    options.forms.gain = std::count(form_blocks.begin(), form_blocks.end(), "gain") > 0;
+    options.forms.shape = std::count(form_blocks.begin(), form_blocks.end(), "shape") > 0;
     options.parameters = parameters;
     const auto s = exact::ComputeExactBounds(options, dss::CeroneExampleStructure(), data, one.box,
                                              [](const exact::ExactBoundsProgress& p) {
@@ -275,7 +297,8 @@ int main(int argc, char** argv) {
                                       "(the intervals bound D inside it), not a proven one"),
         tables, out, threads, lp_budget, sweeps, short_cap, target_ratio, lp_solver, split, gamma_ratio,
         (samples > 0 ? fmt::format(" --samples {}", samples) : std::string()) +
-            (seed > 0 ? fmt::format(" --seed {}", seed) : std::string()));
+            (seed > 0 ? fmt::format(" --seed {}", seed) : std::string()) +
+            fmt::format(" --input-forms {}", fmt::join(form_blocks, ",")));
     md += Table(s, one, truth);
     md += fmt::format("\nStage 2: {:.1f} s wall on {} (prune {:.1f} s, inner hull {:.1f} s, bound {:.1f} s); {} "
                       "levels, {} boxes tested, {} pruned; {} sweeps{}; {} LPs of {} x {} ({} nonzeros), {} not optimal. "
