@@ -104,14 +104,20 @@ TEST(DynamicsForms, AFormRangeAroundTheTruthIsKeptAndOneBesideItIsPruned) {
   EXPECT_EQ(e.verdict, BoxVerdict::kPruned) << inst.description;
 }
 
-// Whole runs with forms (a generous thin share, so most second- and third-order systems get one): the truth and
-// independently found points of D stay inside every interval.
-TEST(DynamicsForms, RunsWithFormsContainTheTruthAndIndependentMembers) {
-  int with_forms = 0, members = 0;
-  std::mt19937 rng(7);
+struct FormRunCounts {
+  int with_forms = 0, with_input_forms = 0, members = 0;
+};
+
+// Whole runs on random systems [first_seed, end_seed) with `forms` (a generous thin share, so most second- and
+// third-order systems get one): the truth and independently found points of D (random steps from the truth,
+// each checked by the membership LP) stay inside every interval.
+FormRunCounts ExpectRunsContainTruthAndMembers(uint64_t first_seed, uint64_t end_seed, FormOptions forms,
+                                               unsigned rng_seed) {
+  FormRunCounts counts;
+  std::mt19937 rng(rng_seed);
   std::normal_distribution<double> step(0.0, 1.0);
   ClpSolver clp;
-  for (uint64_t seed = 201; seed < 221; ++seed) {
+  for (uint64_t seed = first_seed; seed < end_seed; ++seed) {
     testing::RandomHwOptions opts;
     opts.min_samples = 40, opts.max_samples = 70;
     const auto inst = testing::MakeRandomHwInstance(seed, opts);
@@ -123,18 +129,21 @@ TEST(DynamicsForms, RunsWithFormsContainTheTruthAndIndependentMembers) {
     o.search.lp_budget = 4;
     o.sweeps = 2;
     o.evaluation.cheap_window = 0;
+    o.forms = forms;
     o.forms.thin_share = 0.95;
-    o.forms.gain = false;  // the dynamics forms alone (the next test adds the others)
     const ExactBoundsSummary s = ComputeExactBounds(o, inst.structure, inst.data, start);
-    ASSERT_FALSE(s.invalidated) << inst.description;
-    with_forms += !s.forms.empty();
+    EXPECT_FALSE(s.invalidated) << inst.description;
+    if (s.invalidated) continue;
+    counts.with_forms += !s.forms.empty();
+    counts.with_input_forms += std::any_of(s.forms.begin(), s.forms.end(),
+                                           [](const auto& f) { return f.block != FormBlock::kDynamics; });
     std::vector<std::vector<double>> points = {inst.theta};
     for (int trial = 0; trial < 8; ++trial) {
       std::vector<double> p = inst.theta;
       for (double& v : p) v += 1e-3 * step(rng) * std::max(1.0, std::abs(v));
       if (CheckMembership(d, p, clp).member) points.push_back(p);
     }
-    members += static_cast<int>(points.size());
+    counts.members += static_cast<int>(points.size());
     for (const auto& p : points)
       for (int k = 0; k < d.layout.count(); ++k) {
         if (!start[k].contains(p[k])) continue;
@@ -142,8 +151,15 @@ TEST(DynamicsForms, RunsWithFormsContainTheTruthAndIndependentMembers) {
         EXPECT_GE(s.intervals[k].upper.value, p[k]) << inst.description << " " << d.layout.names[k];
       }
   }
-  EXPECT_GE(with_forms, 5);
-  EXPECT_GT(members, 20);
+  return counts;
+}
+
+TEST(DynamicsForms, RunsWithFormsContainTheTruthAndIndependentMembers) {
+  FormOptions dynamics_only;
+  dynamics_only.gain = false;
+  const FormRunCounts counts = ExpectRunsContainTruthAndMembers(201, 221, dynamics_only, 7);
+  EXPECT_GE(counts.with_forms, 5);
+  EXPECT_GT(counts.members, 20);
 }
 
 // A random instance of exactly n samples with at least two b_j and two free gammas.
@@ -229,47 +245,13 @@ TEST(ParameterForms, AThinGainFormRangeKeepsTheTruthAndTiesTheBetasToIt) {
   EXPECT_GT((with_thin - with_wide) / (truth * gamma2 - with_wide), 0.5) << inst.description;
 }
 
-// Whole runs with gain and shape forms besides the dynamics forms: the truth and independently found points of
-// D stay inside every interval.
+// Whole runs with gain and shape forms besides the dynamics forms.
 TEST(ParameterForms, RunsWithInputFormsContainTheTruthAndIndependentMembers) {
-  int with_input_forms = 0, members = 0;
-  std::mt19937 rng(9);
-  std::normal_distribution<double> step(0.0, 1.0);
-  ClpSolver clp;
-  for (uint64_t seed = 231; seed < 243; ++seed) {
-    testing::RandomHwOptions opts;
-    opts.min_samples = 40, opts.max_samples = 70;
-    const auto inst = testing::MakeRandomHwInstance(seed, opts);
-    const LiftedData d = MakeLiftedData(inst.structure, inst.data);
-    const ParamBox start = BoxAround(d, inst.theta, 0.02, 0.3);
-    ExactBoundsOptions o;
-    o.executor = std::make_shared<sdp::InProcessExecutor>();
-    o.prune.max_levels = 4;
-    o.search.lp_budget = 4;
-    o.sweeps = 2;
-    o.evaluation.cheap_window = 0;
-    o.forms.thin_share = 0.95;
-    o.forms.gain = o.forms.shape = true;
-    const ExactBoundsSummary s = ComputeExactBounds(o, inst.structure, inst.data, start);
-    ASSERT_FALSE(s.invalidated) << inst.description;
-    with_input_forms += std::any_of(s.forms.begin(), s.forms.end(),
-                                    [](const auto& f) { return f.block != FormBlock::kDynamics; });
-    std::vector<std::vector<double>> points = {inst.theta};
-    for (int trial = 0; trial < 8; ++trial) {
-      std::vector<double> p = inst.theta;
-      for (double& v : p) v += 1e-3 * step(rng) * std::max(1.0, std::abs(v));
-      if (CheckMembership(d, p, clp).member) points.push_back(p);
-    }
-    members += static_cast<int>(points.size());
-    for (const auto& p : points)
-      for (int k = 0; k < d.layout.count(); ++k) {
-        if (!start[k].contains(p[k])) continue;
-        EXPECT_LE(s.intervals[k].lower.value, p[k]) << inst.description << " " << d.layout.names[k];
-        EXPECT_GE(s.intervals[k].upper.value, p[k]) << inst.description << " " << d.layout.names[k];
-      }
-  }
-  EXPECT_GE(with_input_forms, 4);
-  EXPECT_GT(members, 12);
+  FormOptions input;
+  input.gain = input.shape = true;
+  const FormRunCounts counts = ExpectRunsContainTruthAndMembers(231, 243, input, 9);
+  EXPECT_GE(counts.with_input_forms, 4);
+  EXPECT_GT(counts.members, 12);
 }
 
 }  // namespace
