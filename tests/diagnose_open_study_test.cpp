@@ -356,5 +356,16 @@ TEST(OpenStudy, OutputQuantizerContinuationStartsFromHalfAStep) {
                     Location::kOutput));
 }
 
+// An output dead band at 0 on an output whose median is far from 0 (retired seed 1 100 174, filtered
+// noise, hw:1,1,3,1,0 with a cubic input map, nominal given): the fit found the band (half-width 0.0144
+// against the true 0.0145) and removed three quarters of the held-out error, but the band sat 0.25 of
+// the output's 5-95 % spread from its median, beyond the quarter a band was allowed, and was rejected
+// as physically meaningless (verdict none, fit failed). A fifth of the samples lie above the band and
+// three quarters below it: the band sits inside the data, not at its edge like a clamp.
+TEST(OpenStudy, DeadBandInsideASkewedSignalIsMeaningful) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kDeadzone, Location::kOutput, 1100174), Effect::kDeadzone,
+                    Location::kOutput));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
