@@ -39,6 +39,8 @@ double Mse(const Vec& e, std::size_t from, std::size_t to) {
 }
 
 // Batch-means z statistic of mean(e0^2 - e1^2) > 0 on [from, to): batches absorb the residual's colour.
+// kZRounding: how far below a bound a z computed from sums may fall by rounding alone.
+constexpr double kZRounding = 1e-9;
 double PairedZ(const Vec& e0, const Vec& e1, std::size_t from, std::size_t to, int batch) {
   const std::size_t n = to > from ? to - from : 0;
   if (n / std::max(batch, 1) < 5) batch = static_cast<int>(std::max<std::size_t>(1, n / 5));
@@ -133,7 +135,11 @@ struct Context {
     c.z = PairedZ(e0, e1, from, to, batch);
     // A large reduction concentrated in a few batches (a limit reached a few times) has a modest batch z
     // although it is far beyond what noise does: half the (penalised) mean square removed and z >= 1 count.
-    c.significant = (c.z >= z_needed && c.score >= o.min_improvement) || (c.score >= 0.5 && c.z >= 1.0);
+    // Two models that differ only where a block acts (BlocksNeeded) differ by exactly 0 in every other
+    // batch, and a block acting within one batch then gives z = 1 exactly, which rounding puts on either
+    // side of 1 (retired seed 1 100 049, fitted nominal: z = 0.99999..., removing the output saturation
+    // multiplied the held-out MSE by 16, and the fit was called failed).
+    c.significant = (c.z >= z_needed && c.score >= o.min_improvement) || (c.score >= 0.5 && c.z >= 1.0 - kZRounding);
     return c;
   }
 };
