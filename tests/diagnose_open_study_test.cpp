@@ -356,5 +356,31 @@ TEST(OpenStudy, OutputQuantizerContinuationStartsFromHalfAStep) {
                     Location::kOutput));
 }
 
+// An output dead band at 0 on an output whose median is far from 0 (retired seed 1 100 174, filtered
+// noise, hw:1,1,3,1,0 with a cubic input map, nominal given): the fit found the band (half-width 0.0144
+// against the true 0.0145) and removed three quarters of the held-out error, but the band sat 0.25 of
+// the output's 5-95 % spread from its median, beyond the quarter a band was allowed, and was rejected
+// as physically meaningless (verdict none, fit failed). A fifth of the samples lie above the band and
+// three quarters below it: the band sits inside the data, not at its edge like a clamp.
+TEST(OpenStudy, DeadBandInsideASkewedSignalIsMeaningful) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kDeadzone, Location::kOutput, 1100174), Effect::kDeadzone,
+                    Location::kOutput));
+}
+
+// An output saturation reached in one stretch of the held-out tail (retired seed 1 100 049, multisine,
+// hw:2,2,1,3,2, fitted nominal): the fit removed 88 % of the held-out error, and removing its block
+// (nominal part kept) made the tail 16 times worse, but the two models differ only where the limit
+// acts, within one batch, which gives the batch z exactly 1; rounding put it below 1, the block seemed
+// not needed and the fit was called failed (verdict none).
+TEST(NominalStatus, ALimitActingWithinOneBatchIsNeeded) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kSaturation;
+  so.location = Location::kOutput;
+  so.seed = 1100049;
+  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/true).report;
+  EXPECT_TRUE(Names(r, Effect::kSaturation, Location::kOutput));
+  EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
+}
+
 }  // namespace
 }  // namespace hw::diagnose
