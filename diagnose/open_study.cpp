@@ -196,6 +196,30 @@ std::string OpenStudyResult::to_markdown(const std::string& command, bool verbos
   return s;
 }
 
+namespace {
+
+// Copies seed's cases (one per mode) or its skip from an earlier run into res; false when that run did not
+// finish the scenario (it is then diagnosed).
+bool TakeFromEarlierRun(const OpenStudyResult& earlier, unsigned seed, const std::vector<NominalMode>& modes,
+                        OpenStudyResult& res) {
+  if (std::find(earlier.skipped_seeds.begin(), earlier.skipped_seeds.end(), seed) != earlier.skipped_seeds.end()) {
+    res.skipped_seeds.push_back(seed);
+    return true;
+  }
+  std::vector<OpenCase> found;
+  for (NominalMode m : modes)
+    for (const auto& c : earlier.cases)
+      if (c.seed == seed && c.mode == m) {
+        found.push_back(c);
+        break;
+      }
+  if (found.size() != modes.size()) return false;
+  res.cases.insert(res.cases.end(), found.begin(), found.end());
+  return true;
+}
+
+}  // namespace
+
 OpenStudyResult RunOpenStudy(const OpenStudyOptions& o) {
   std::string err;
   if (!o.IsValid(&err)) throw InputError(err);
@@ -216,6 +240,7 @@ OpenStudyResult RunOpenStudy(const OpenStudyOptions& o) {
   }
   for (std::size_t i = 0; i < plan.size(); ++i) {
     if (static_cast<int>(i % o.shards) != o.shard) continue;
+    if (o.resume && TakeFromEarlierRun(*o.resume, o.first_seed + static_cast<unsigned>(i), o.modes, res)) continue;
     OpenScenarioOptions so = o.scenario;
     so.effect = plan[i].first;
     so.location = plan[i].second;
@@ -245,7 +270,8 @@ OpenStudyResult RunOpenStudy(const OpenStudyOptions& o) {
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.on_scenario) o.on_scenario(res);
   }
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() +
+                (o.resume ? o.resume->seconds : 0.0);
   return res;
 }
 

@@ -29,6 +29,9 @@ struct OpenStudyOptions {
   int shard = 0, shards = 1;     // run only scenarios i with i % shards == shard (seeds stay first_seed + i)
   // Called after every scenario with the cases so far (e.g. to write partial results atomically).
   std::function<void(const struct OpenStudyResult&)> on_scenario;
+  // The partial result of an earlier run of the same study: its scenarios (a seed with a case for every mode,
+  // or skipped) are taken from it, not diagnosed again — a stopped run resumes.
+  const struct OpenStudyResult* resume = nullptr;
   DiagnoseOptions diagnose;
   bool IsValid(std::string* error) const;
 };

@@ -3,7 +3,8 @@
 // effect sizes 0.5-3 noise standard deviations, record lengths and operating-point offsets; every
 // scenario is diagnosed with the true nominal given (--model) and with its structure fitted (--fit).
 // Writes OUT/open_study.md and OUT/open_study.json (per-class rates with Wilson 95 % intervals, misses),
-// rewritten atomically after every scenario so that a run stopped early still leaves its results.
+// rewritten atomically after every scenario so that a run stopped early still leaves its results; the same
+// command on the same OUT resumes such a run (its finished scenarios are read back, not diagnosed again).
 //
 // Usage: diagnose_open_study OUT [PER_ROW] [NULLS] [FIRST_SEED] [MODES] [SHARD/SHARDS] [ROWS]
 //        diagnose_open_study --merge OUT DIR...   (one table from the shards' open_study.json)
@@ -14,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <fmt/format.h>
@@ -40,6 +42,21 @@ std::string CommandLine(int argc, char** argv) {
   std::string command = "build/paper_examples/diagnose_open_study";
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
   return command;
+}
+
+// The results an earlier run of the same command left in OUT (none when OUT holds none); an OUT written by
+// another command is refused, so that a resumed study never mixes two.
+std::optional<OpenStudyResult> EarlierRun(const std::string& out, const std::string& command) {
+  std::ifstream json(out + "/open_study.json"), md(out + "/open_study.md");
+  if (!json) return std::nullopt;
+  std::string line, recorded;
+  while (std::getline(md, line))
+    if (line.rfind("Command: `", 0) == 0) recorded = line.substr(10, line.rfind('`') - 10);
+  if (recorded != command)
+    throw hw::InputError(fmt::format("{}/open_study.json: written by `{}`, not by this command; resume with that "
+                                     "command or choose another OUT",
+                                     out, recorded.empty() ? "an unknown command" : recorded));
+  return OpenStudyResult::FromJson(nlohmann::json::parse(json));
 }
 
 int Merge(int argc, char** argv) {
@@ -89,6 +106,11 @@ int main(int argc, char** argv) {
     o.diagnose.threads = 1;
     o.progress = true;
     const std::string command = CommandLine(argc, argv);
+    const std::optional<OpenStudyResult> earlier = EarlierRun(out, command);
+    if (earlier) {
+      o.resume = &*earlier;
+      fmt::print(stderr, "resuming: {} diagnoses read from {}/open_study.json\n", earlier->cases.size(), out);
+    }
     o.on_scenario = [&](const OpenStudyResult& partial) { WriteResults(partial, out, command); };
     const OpenStudyResult res = RunOpenStudy(o);
     WriteResults(res, out, command);

@@ -139,6 +139,29 @@ TEST(OpenStudy, HandfulOfScenarios) {
   EXPECT_GE(named, effects * 5 / 8) << named << " of " << effects;
 }
 
+// A stopped run resumes: the scenarios an earlier run finished are taken from it (here a marked verdict, so a
+// diagnosis run again would show), the others diagnosed, and the result is the whole run's.
+TEST(OpenStudy, AStoppedRunResumesFromItsFinishedScenarios) {
+  OpenStudyOptions o;
+  o.rows = {{Effect::kBacklash, Location::kInput}};
+  o.scenarios_per_row = 2;
+  o.null_scenarios = 0;
+  o.first_seed = 601;
+  o.modes = {NominalMode::kGiven};
+  o.diagnose.threads = 1;
+  const OpenStudyResult whole = RunOpenStudy(o);
+  ASSERT_EQ(whole.cases.size(), 2u);
+  OpenStudyResult stopped = whole;
+  stopped.cases.resize(1);
+  stopped.cases[0].verdict = "taken from the earlier run";
+  o.resume = &stopped;
+  const OpenStudyResult resumed = RunOpenStudy(o);
+  ASSERT_EQ(resumed.cases.size(), 2u);
+  EXPECT_EQ(resumed.cases[0].verdict, "taken from the earlier run");
+  EXPECT_EQ(resumed.cases[1].seed, whole.cases[1].seed);
+  EXPECT_EQ(resumed.cases[1].verdict, whole.cases[1].verdict);
+}
+
 // A stiction scenario must show its stick-slip jump: when every input move is larger than the static
 // band, stiction gives the same signal as backlash with the kinetic band as its play, and the scenario
 // is backlash under another name. The generator sizes stiction by what neither the nominal nor backlash
