@@ -50,17 +50,30 @@ class RowBuilder {
 
 Interval ColumnRange(const LpProblem& lp, int col) { return {lp.col_lo[col], lp.col_hi[col]}; }
 
-// Four McCormick rows of prod = x * y over x in X, y in Y.
-void AddMcCormick(LpProblem* lp, int prod, int x, Interval X, int y, Interval Y) {
+// Four McCormick rows of x * y = sum_c coefficient_c * column_c over x in X, y in Y (one column with coefficient
+// 1 for a product of its own; a combination of products for a form's, exact/parameter_forms.hpp).
+void AddMcCormick(LpProblem* lp, const std::vector<std::pair<int, double>>& product, int x, Interval X, int y,
+                  Interval Y) {
   RowBuilder r(lp);
+  auto add_product = [&] {
+    for (const auto& [col, c] : product) r.Add(col, c);
+  };
   // (x - xl)(y - yl) >= 0: prod - yl x - xl y >= -xl yl
-  r.Add(prod, 1).Add(x, -Y.lo).Add(y, -X.lo).AtLeast(-(Interval(X.lo) * Y.lo));
+  add_product();
+  r.Add(x, -Y.lo).Add(y, -X.lo).AtLeast(-(Interval(X.lo) * Y.lo));
   // (xu - x)(yu - y) >= 0: prod - yu x - xu y >= -xu yu
-  r.Add(prod, 1).Add(x, -Y.hi).Add(y, -X.hi).AtLeast(-(Interval(X.hi) * Y.hi));
+  add_product();
+  r.Add(x, -Y.hi).Add(y, -X.hi).AtLeast(-(Interval(X.hi) * Y.hi));
   // (x - xl)(yu - y) >= 0: prod - yu x - xl y <= -xl yu
-  r.Add(prod, 1).Add(x, -Y.hi).Add(y, -X.lo).AtMost(-(Interval(X.lo) * Y.hi));
+  add_product();
+  r.Add(x, -Y.hi).Add(y, -X.lo).AtMost(-(Interval(X.lo) * Y.hi));
   // (xu - x)(y - yl) >= 0: prod - yl x - xu y <= -xu yl
-  r.Add(prod, 1).Add(x, -Y.lo).Add(y, -X.hi).AtMost(-(Interval(X.hi) * Y.lo));
+  add_product();
+  r.Add(x, -Y.lo).Add(y, -X.hi).AtMost(-(Interval(X.hi) * Y.lo));
+}
+
+void AddMcCormick(LpProblem* lp, int prod, int x, Interval X, int y, Interval Y) {
+  AddMcCormick(lp, {{prod, 1.0}}, x, X, y, Y);
 }
 
 }  // namespace
@@ -385,24 +398,9 @@ class LiftedLpBuilder {
             const double c = gain_side[g].coef[j] * shape_side[h].coef[k];
             if (c != 0.0) product.emplace_back(out_.beta_col[j][k + 1], c);
           }
-        AddProductEnvelope(product, gain_side[g].col, gain_side[g].range, shape_side[h].col, shape_side[h].range);
+        AddMcCormick(&out_.lp, product, gain_side[g].col, gain_side[g].range, shape_side[h].col,
+                     shape_side[h].range);
       }
-  }
-
-  // Four McCormick rows of x * y = sum of coefficient * column over x in X, y in Y (the coefficients are products
-  // of form coefficients rounded to 2^-20, exact in double).
-  void AddProductEnvelope(const std::vector<std::pair<int, double>>& product, int x, Interval X, int y, Interval Y) {
-    auto add_product = [&] {
-      for (const auto& [col, c] : product) row_.Add(col, c);
-    };
-    add_product();  // (x - xl)(y - yl) >= 0
-    row_.Add(x, -Y.lo).Add(y, -X.lo).AtLeast(-(Interval(X.lo) * Y.lo));
-    add_product();  // (xu - x)(yu - y) >= 0
-    row_.Add(x, -Y.hi).Add(y, -X.hi).AtLeast(-(Interval(X.hi) * Y.hi));
-    add_product();  // (x - xl)(yu - y) >= 0
-    row_.Add(x, -Y.hi).Add(y, -X.lo).AtMost(-(Interval(X.lo) * Y.hi));
-    add_product();  // (xu - x)(y - yl) >= 0
-    row_.Add(x, -Y.lo).Add(y, -X.hi).AtMost(-(Interval(X.hi) * Y.lo));
   }
 
   // The assumption: p(alpha, .) increases over the data range, so it increases between grid points.
