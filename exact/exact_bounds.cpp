@@ -468,7 +468,7 @@ ExactBoundsSummary ComputeExactBounds(const ExactBoundsOptions& options, const d
     // Every interval within its target: a further sweep would narrow what needs no narrowing.
     if (sweep >= 2 && inner_ranges && AllWithinTarget(s.intervals, options.target_ratio)) break;
     const bool closing = sweep > options.sweeps;
-    const std::string phase = sweep == 0   ? std::string("bound (the dynamics forms)")
+    const std::string phase = sweep == 0   ? std::string("bound (the forms' ranges)")
                               : closing    ? std::string("bound (closing pass, the endpoints short of their target)")
                                            : fmt::format("bound (sweep {} of {}, endpoints)", sweep, options.sweeps);
     ParamBox sweep_start = start_box;
