@@ -889,8 +889,15 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   // relay's in its threshold (every threshold changes which input moves switch it), a dead band's in its
   // width and centre on an input of few levels (each level inside or outside the band): their grid
   // points scored with the baseline's numerator are a poor guide, and more of them are refined.
+  // A rate limit's grid points are misranked for another reason: the baseline's poles have absorbed
+  // the ramps the limit makes, so on its dynamics every limit slows the response once more, and the
+  // scores fall steadily with the limit (the mildest limits rank first, the true one far below them);
+  // refitted, the true limit's cost is several times lower. Refining four times as many of them
+  // reaches limits well inside the jumps, from which LM moves smoothly (the cost is continuous in the
+  // limit).
   const bool jagged = effect == Effect::kQuantization || effect == Effect::kHysteresis || effect == Effect::kDeadzone;
-  const int refine = jagged ? 4 * o.keep_grid_points : o.keep_grid_points;
+  const bool misranked = jagged || effect == Effect::kRateLimit;
+  const int refine = misranked ? 4 * o.keep_grid_points : o.keep_grid_points;
   const int keep = std::min<int>(refine, static_cast<int>(scored.size()));
   for (int i = 0; i < keep; ++i) {
     AugmentedModel m = scored[i].second;

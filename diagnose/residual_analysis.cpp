@@ -180,6 +180,20 @@ void FindBias(const std::vector<Condition>& conditions, const std::vector<double
 }
 }  // namespace
 
+// Mean square where a rule holds over that where it does not, at most kMaxLift. What an effect block
+// changes in the prediction is exactly zero, or decays to round-off (1e-40 and below), away from where
+// the block acts: the plain ratio then reads 1e47, a figure of the round-off, not of the data.
+namespace {
+constexpr double kMaxLift = 1e6;
+double Lift(double ms_in, double ms_out) {
+  if (ms_in <= 0.0) return 0.0;
+  return ms_in >= kMaxLift * ms_out ? kMaxLift : ms_in / ms_out;
+}
+std::string LiftText(double lift) {
+  return lift >= kMaxLift ? fmt::format("over {:.0f}x", kMaxLift) : fmt::format("{:.1f}x", lift);
+}
+}  // namespace
+
 Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::vector<bool>& mask,
                           const std::vector<double>& e, std::size_t skip, const std::string& subject) {
   Region best;
@@ -221,7 +235,7 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
         if (sel == 0 || n_out == 0) continue;
         const double prec = double(tp) / sel, rec = double(tp) / nmask;
         const double f1 = prec + rec > 0 ? 2 * prec * rec / (prec + rec) : 0.0;
-        const double lift = (e_in / n_in) / std::max(e_out / n_out, 1e-300);
+        const double lift = Lift(e_in / n_in, e_out / n_out);
         const double concentration = e_in / std::max(e_total, 1e-300) - n_in / nall;
         const double score = informative ? f1 : concentration;
         if (score > best_score && lift > 1.3 && n_in >= 0.05 * nall) {
@@ -259,12 +273,12 @@ Region CharacteriseRegion(const std::vector<Condition>& conditions, const std::v
   }
   if (informative)
     best.description = fmt::format("{} (covers {:.0f} % of the flagged samples; {:.0f} % of the samples meeting it "
-                                   "are flagged; mean-square {} there {:.1f}x elsewhere)",
-                                   d, 100 * best.recall, 100 * best.precision, subject, best.lift);
+                                   "are flagged; mean-square {} there {} elsewhere)",
+                                   d, 100 * best.recall, 100 * best.precision, subject, LiftText(best.lift));
   else
     best.description = fmt::format("{} beyond the noise almost everywhere ({:.0f} % of the samples); it is largest "
-                                   "for {} (mean-square {} there {:.1f}x elsewhere)",
-                                   subject, 100.0 * nmask / nall, d, subject, best.lift);
+                                   "for {} (mean-square {} there {} elsewhere)",
+                                   subject, 100.0 * nmask / nall, d, subject, LiftText(best.lift));
   if (best.bias.found) best.description += "; " + best.bias.description;
   return best;
 }

@@ -46,7 +46,7 @@ struct Region {
   double threshold = 0.0;
   double precision = 0.0;    // fraction of samples meeting the rule that lie in the mismatch windows
   double recall = 0.0;       // fraction of mismatch samples meeting the rule
-  double lift = 0.0;         // mean squared error where the rule holds / where it does not
+  double lift = 0.0;         // mean squared error where the rule holds / where it does not (at most 1e6)
   std::string description;   // e.g. "within 6 samples after a reversal of u"
   // Signed evidence: the split of one condition across which the mean error changes most (in units of
   // the error's standard deviation), e.g. a backlash offset that follows the direction of u.

@@ -405,5 +405,16 @@ TEST(NominalStatus, ALimitActingWithinOneBatchIsNeeded) {
   EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
 }
 
+// A rate limit on steps under a quadratic output map (retired seed 1 200 004, hw:3,2,1,3,1, true limit
+// 0.499 per sample): the baseline's poles absorbed the ramps, so the limit's grid points, scored with the
+// baseline's numbers, ranked the mildest limits first (scores falling steadily with the limit); the three
+// refined reached 1.75 at best, which explained a third of the excess, and the fit was called failed
+// (verdict none). Refined from more grid points, the fit finds the limit (0.50).
+TEST(OpenStudy, RateLimitGridPointsRankedByTheBaselineAreRefinedWellInsideTheJumps) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kRateLimit, Location::kInput, 1200004);
+  ASSERT_TRUE(Names(r, Effect::kRateLimit, Location::kInput));
+  EXPECT_NEAR(r.verdict_blocks.front().params[0], 0.499, 0.05);
+}
+
 }  // namespace
 }  // namespace hw::diagnose

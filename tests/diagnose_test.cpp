@@ -401,6 +401,23 @@ TEST(Refit, FrictionIsNeverReportedWithANegativeLevel) {
   EXPECT_NE(r.verdict, Effect::kCoulombFriction) << r.message;
 }
 
+// What an effect block changes in the prediction decays to round-off away from where it acts: the
+// ratio of mean squares there and elsewhere is capped instead of reading 1e40 (a figure of round-off).
+TEST(ResidualAnalysis, ChangeThatIsRoundOffElsewhereGivesACappedRatio) {
+  const std::size_t n = 1000;
+  Vec u(n), change(n);
+  std::vector<bool> mask(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    u[t] = std::sin(0.01 * t);
+    mask[t] = u[t] > 0.8;
+    change[t] = mask[t] ? 0.3 : 1e-25 * std::cos(0.3 * t);
+  }
+  const Region region = CharacteriseRegion(OperatingConditions(u, u), mask, change, 0, "change");
+  ASSERT_TRUE(region.found);
+  EXPECT_LE(region.lift, 1e6);
+  EXPECT_EQ(region.description.find("e+"), std::string::npos) << region.description;
+}
+
 TEST(ResidualAnalysis, WindowsRegionAndCorrelationTests) {
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g(0.0, 1.0);
