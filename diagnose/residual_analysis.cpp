@@ -169,21 +169,22 @@ void FindBias(const std::vector<Condition>& conditions, const std::vector<double
     return;
   }
   const auto& b = r->bias;
-  const bool dir = b.condition == "dir_u" || b.condition == "dir_y";
+  const bool follows_direction = b.condition == "dir_u" || b.condition == "dir_y";
   const std::string sig = b.condition.find('u') != std::string::npos ? "u" : "y";
-  b.condition == "dir_u" || b.condition == "dir_y"
-      ? r->bias.description = fmt::format("the {0}'s sign follows the direction of {1}: mean {2:+.4g} after {1} rose, {3:+.4g} after it fell "
-                                          "({4:.2f} {0} standard deviations apart)", subject, sig, b.mean_above, b.mean_below, b.effect_size)
-      : r->bias.description = fmt::format("the mean {} differs across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} {} "
-                                          "standard deviations apart)", subject, b.condition, b.threshold, b.mean_above, b.mean_below, b.effect_size, subject);
-  (void)dir;
+  if (follows_direction)
+    r->bias.description = fmt::format(
+        "the {0}'s sign follows the direction of {1}: mean {2:+.4g} after {1} rose, {3:+.4g} after it fell "
+        "({4:.2f} {0} standard deviations apart)",
+        subject, sig, b.mean_above, b.mean_below, b.effect_size);
+  else
+    r->bias.description = fmt::format(
+        "the mean {} differs across {} = {:.4g}: {:+.4g} above, {:+.4g} below ({:.2f} {} standard deviations apart)",
+        subject, b.condition, b.threshold, b.mean_above, b.mean_below, b.effect_size, subject);
 }
-}  // namespace
 
 // Mean square where a rule holds over that where it does not, at most kMaxLift. What an effect block
 // changes in the prediction is exactly zero, or decays to round-off (1e-40 and below), away from where
 // the block acts: the plain ratio then reads 1e47, a figure of the round-off, not of the data.
-namespace {
 constexpr double kMaxLift = 1e6;
 double Lift(double ms_in, double ms_out) {
   if (ms_in <= 0.0) return 0.0;
