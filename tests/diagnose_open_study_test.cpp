@@ -416,5 +416,15 @@ TEST(OpenStudy, RateLimitGridPointsRankedByTheBaselineAreRefinedWellInsideTheJum
   EXPECT_NEAR(r.verdict_blocks.front().params[0], 0.499, 0.05);
 }
 
+// An input quantizer on steps under a cubic output map (retired seed 1 300 258, hw:3,3,1,3,1, nominal
+// given): the held-out tail confirmed the quantizer (0.17x the baseline's) and validation did not (1.34x,
+// step 0.1861): the search among the steps that round the identification recording's levels alike
+// re-solved the numerator, which a non-identity output map does not allow, so none was tried. Scaling the
+// grid and composing the input map with the inverse scaling predicts alike; validation judges the ties.
+TEST(OpenStudy, InputQuantizerTiesUnderANonlinearMapAreJudgedOnValidation) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kInput, 1300258), Effect::kQuantization,
+                    Location::kInput));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
