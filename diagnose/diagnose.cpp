@@ -260,6 +260,24 @@ enum class TieRun { kContiguous, kScattered };
 // map's numerator divided by it), which predicts alike wherever the samples round to the same level.
 enum class TieResolve { kNone, kNumerator, kScaleInputMap };
 
+// Composes the model's input map with the inverse of a scaling of the quantized input by `factor` (an identity
+// map's numerator divided by it; a polynomial's coefficient k by factor^(k+1)); false where that cannot be done.
+bool UndoInputScaling(AugmentedModel* m, double factor) {
+  if (!(factor > 0) || !std::isfinite(factor)) return false;
+  StaticMap& in = m->nominal.input;
+  if (in.kind == StaticMap::Kind::kIdentity) {
+    for (double& b : m->nominal.linear.b) b /= factor;
+    return true;
+  }
+  if (in.kind != StaticMap::Kind::kPolynomial) return false;
+  double power = factor;
+  for (double& coefficient : in.coefficients) {
+    coefficient /= power;
+    power *= factor;
+  }
+  return true;
+}
+
 // Among `points` (values of the parameters `params` of the model's one block), the model that predicts
 // `agree` exactly as `model` does and scores lowest by `mse` (the data that judge it); `model` itself
 // when none scores lower.
@@ -269,18 +287,7 @@ AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, cons
   const auto resolved = [&](AugmentedModel* t) {
     if (resolve == TieResolve::kNone) return true;
     if (resolve == TieResolve::kNumerator) return SolveNumerator(t, agree, c.o.refit);
-    const double factor = t->blocks[0].params[0] / model.blocks[0].params[0];
-    if (!(factor > 0) || !std::isfinite(factor)) return false;
-    StaticMap& in = t->nominal.input;
-    if (in.kind == StaticMap::Kind::kIdentity) {
-      for (double& b : t->nominal.linear.b) b /= factor;
-    } else if (in.kind == StaticMap::Kind::kPolynomial) {
-      double power = factor;
-      for (double& k : in.coefficients) k /= power, power *= factor;
-    } else {
-      return false;
-    }
-    return true;
+    return UndoInputScaling(t, t->blocks[0].params[0] / model.blocks[0].params[0]);
   };
   AugmentedModel reference = model;
   if (!resolved(&reference)) return model;
