@@ -426,5 +426,15 @@ TEST(OpenStudy, InputQuantizerTiesUnderANonlinearMapAreJudgedOnValidation) {
                     Location::kInput));
 }
 
+// An output quantizer under a cubic input map on a two-level input (retired seed 1 300 374, PRBS,
+// hw:3,1,3,1,0): the identification recording fixes the map only at its two levels, the quantizer's
+// fit carried the map's shape elsewhere with the same prediction, and validation, at other levels,
+// rejected it (2.69x the baseline's error). The model with the baseline's map shape matched at the two
+// levels predicts the identification recording alike, and validation judges the two.
+TEST(OpenStudy, InputMapShapeLeftFreeByATwoLevelInputIsJudgedOnValidation) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1300374), Effect::kQuantization,
+                    Location::kOutput));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
