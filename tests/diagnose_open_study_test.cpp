@@ -426,5 +426,30 @@ TEST(OpenStudy, InputQuantizerTiesUnderANonlinearMapAreJudgedOnValidation) {
                     Location::kInput));
 }
 
+// An output quantizer under a cubic input map on a two-level input (retired seed 1 300 374, PRBS,
+// hw:3,1,3,1,0): the identification recording fixes the map only at its two levels, the quantizer's
+// fit carried the map's shape elsewhere with the same prediction, and validation, at other levels,
+// rejected it (2.69x the baseline's error). The model with the baseline's map shape matched at the two
+// levels predicts the identification recording alike, and validation judges the two.
+TEST(OpenStudy, InputMapShapeLeftFreeByATwoLevelInputIsJudgedOnValidation) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1300374), Effect::kQuantization,
+                    Location::kOutput));
+}
+
+// An input quantizer under a cubic input map on steps (retired seed 1 300 078, hw:3,3,3,1,2): the fitted
+// grid (step 0.379, offset -0.1 step) and the true one (0.398, offset 0) put every identification sample
+// on the same level index, and the cubic composed with the affine change between the grids predicts the
+// recording alike; the search among ties reached only the steps within 3 % with the offset scaled along,
+// and validation rejected the fit (1.95x the baseline's error). Both nominals.
+TEST(OpenStudy, InputQuantizerGridsThatIndexTheSamplesAlikeAreJudgedOnValidation) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kQuantization;
+  so.location = Location::kInput;
+  so.seed = 1300078;
+  for (bool fitted : {false, true})
+    EXPECT_TRUE(Names(DiagnoseOpenScenario(so, fitted).report, Effect::kQuantization, Location::kInput))
+        << (fitted ? "fitted" : "given");
+}
+
 }  // namespace
 }  // namespace hw::diagnose
