@@ -908,6 +908,39 @@ void SettleStictionBacklash(const Context& c, std::vector<Finding>* fs) {
   }
 }
 
+// Two eligible candidates that place one kind of limit in two places often fit alike: an output saturation
+// and a state saturation clip the same samples and differ only in how the output leaves the limit (the
+// state saturation's block recovers at once, the output's follows the unclipped state). As for stiction
+// and backlash, the first one's residual on unseen data is
+// regressed on the difference of the two predictions (StickSlipZ): when the coefficient differs from 0.5
+// by at least 2 standard errors, the one it favours is ranked first; otherwise the evidence of both says
+// they tie, and the ranking by penalised score stands.
+void SettleLimitLocations(const Context& c, std::vector<Finding>* fs, Effect ea, Location la, Effect eb, Location lb) {
+  Finding *a = nullptr, *b = nullptr;
+  for (auto& f : *fs) {
+    if (!f.eligible || f.blocks.size() != 1) continue;
+    if (f.blocks.front().effect == ea && f.blocks.front().location == la) a = &f;
+    if (f.blocks.front().effect == eb && f.blocks.front().location == lb) b = &f;
+  }
+  if (!a || !b) return;
+  double share = 0.0;
+  const double z = StickSlipZ(c, *a, *b, &share);
+  const std::string where = fmt::format("in the difference of the two predictions on unseen data (the {} residual's "
+                                        "coefficient on it {:.2f}: 0 favours {}, 1 {})",
+                                        a->Label(), share, a->Label(), b->Label());
+  if (z >= 2.0) {
+    b->score = std::max(b->score, a->score + 1e-9);
+    b->evidence += fmt::format("; ranked above {} {} (z = {:.1f})", a->Label(), where, z);
+  } else if (z <= -2.0) {
+    a->score = std::max(a->score, b->score + 1e-9);
+    a->evidence += fmt::format("; ranked above {} {} (z = {:.1f})", b->Label(), where, -z);
+  } else {
+    const std::string tie = fmt::format("; {} and {} tie {} (z = {:.1f})", a->Label(), b->Label(), where, z);
+    a->evidence += tie;
+    b->evidence += tie;
+  }
+}
+
 std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
   const auto candidates = c.o.candidates.empty() ? CandidateEffects() : c.o.candidates;
   std::vector<Finding> out(candidates.size());
@@ -917,6 +950,7 @@ std::vector<Finding> SearchSingles(const Context& c, const Reference& base) {
   PreferBacklashToJumplessStiction(&out);
   for (auto& f : out) f.evidence = Evidence(f);
   SettleStictionBacklash(c, &out);
+  SettleLimitLocations(c, &out, Effect::kSaturation, Location::kOutput, Effect::kStateSaturation, Location::kState);
   RankFindings(&out);
   return out;
 }
