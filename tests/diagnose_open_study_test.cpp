@@ -451,5 +451,35 @@ TEST(OpenStudy, InputQuantizerGridsThatIndexTheSamplesAlikeAreJudgedOnValidation
         << (fitted ? "fitted" : "given");
 }
 
+// An input dead band in a gap between two levels of a step input (retired seeds 1 300 200, hw:2,1,3,1,0,
+// and 1 300 254, hw:2,1,3,1,2, nominal given): every centre that leaves the band in that gap predicts the
+// identification recording alike (the samples outside the band are shifted by its half-width whatever its
+// centre); the fit put the band at the far end of the gap (centres 0.569 and -0.227 against the true 0),
+// validation, with levels inside the gap, found it worse than none (2.71x, 1.31x) and the output dead band
+// was named. Likewise in 1 300 128 (closed loop, hw:1,2,1,3,2), whose input jumps across the band (centre
+// 0.272, validation 2.41x). Judged among the centres that predict the identification recording alike (to a
+// tenth of its residual RMS), validation finds the band near 0.
+TEST(OpenStudy, InputDeadBandCentreInAGapOfTheInputIsJudgedAmongItsTies) {
+  for (unsigned seed : {1300200u, 1300254u, 1300128u})
+    EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kDeadzone, Location::kInput, seed), Effect::kDeadzone,
+                      Location::kInput))
+        << "seed " << seed;
+}
+
+// An output saturation and a state saturation both eligible: ranked by the penalised scores alone, the
+// state saturation came first in retired seed 1 300 067 (steps, hw:1,3,1,3,0, nominal given: scores 0.710
+// against 0.710, held-out 0.155x against 0.219x, validation 0.525x against 0.395x). The output saturation's
+// residual regressed on the difference of the two predictions on unseen data favours it by 2 standard
+// errors; in 1 300 229 (filtered noise, linear:1,1,2) the two predict alike (0.256x / 0.261x held-out,
+// 0.632x / 0.633x validation) and the report says they tie.
+TEST(OpenStudy, OutputAndStateSaturationAreSettledByTheirPredictionDifference) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1300067), Effect::kSaturation,
+                    Location::kOutput));
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1300229);
+  ASSERT_FALSE(r.findings.empty());
+  EXPECT_NE(r.findings.front().evidence.find("saturation@output and state_saturation@state tie"), std::string::npos)
+      << r.findings.front().evidence;
+}
+
 }  // namespace
 }  // namespace hw::diagnose
