@@ -11,7 +11,8 @@
 //   defaults: PER_ROW 2, NULLS 4, FIRST_SEED 100001, MODES given,fitted, SHARD/SHARDS 0/1,
 //   ROWS every effect row (or a comma-separated subset such as stiction@input,backlash@input, for
 //   development runs on the tuning seeds)
-// Seed ranges: 1..99999 are for tuning (development runs), 100001.. for the reported results.
+// Seed ranges: 1..99999 are for tuning (development runs); from 100001 on, each reporting range is run
+// once with the method frozen and is retired (a development range) afterwards (docs/diagnose.md, "Open study").
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
