@@ -217,6 +217,79 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
   return true;
 }
 
+bool SolveNumeratorThroughOutputMap(AugmentedModel* m, const Segment& s, const RefitOptions& o, int iterations) {
+  const StaticMap& g = m->nominal.output;
+  if (g.kind != StaticMap::Kind::kPolynomial || HasStateBlock(*m)) return false;
+  for (const auto& b : m->blocks)
+    if (b.location == Location::kOutput) return false;
+  Vec x = *s.u;
+  for (const auto& b : m->blocks) x = ApplyInputBlock(b, x);
+  for (auto& v : x) v = m->nominal.input(v);
+  const auto& a = m->nominal.linear.a;
+  const Vec f = LinearBlock{a, {1.0}, 0}.simulate(x);
+  const int nb = static_cast<int>(m->nominal.linear.b.size());
+  const int ninit = o.estimate_initial_state ? static_cast<int>(a.size()) : 0;
+  const long d = m->nominal.linear.delay;
+  const std::size_t n = s.End();
+  if (s.Count() <= static_cast<std::size_t>(nb + ninit + 1)) return false;
+  std::vector<Vec> h(ninit);
+  for (int i = 0; i < ninit; ++i) {
+    AugmentedModel free;
+    free.nominal.linear = {a, {0.0}, 0};
+    free.initial_state.assign(ninit, 0.0);
+    free.initial_state[i] = 1.0;
+    free.simulate(Vec(n, 0.0), &h[i]);
+  }
+  // z = phi theta (theta: numerator, initial state), linear as under an identity output map.
+  const int nz = nb + ninit;
+  Eigen::MatrixXd phi(s.Count(), nz);
+  for (std::size_t t = s.skip; t < n; ++t) {
+    const std::size_t r = t - s.skip;
+    int c = 0;
+    for (int j = 0; j < nb; ++j) {
+      const long k = static_cast<long>(t) - d - j;
+      phi(r, c++) = k >= 0 ? f[k] : 0.0;
+    }
+    for (int i = 0; i < ninit; ++i) phi(r, c++) = h[i][t];
+  }
+  Eigen::VectorXd theta(nz);
+  for (int j = 0; j < nb; ++j) theta(j) = m->nominal.linear.b[j];
+  for (int i = 0; i < ninit; ++i) theta(nb + i) = i < static_cast<int>(m->initial_state.size()) ? m->initial_state[i] : 0.0;
+  double offset = m->output_offset;
+  const auto slope = [&g](double v) {
+    double acc = 0.0;
+    for (std::size_t k = g.coefficients.size(); k-- > 0;) acc = acc * v + (k + 1) * g.coefficients[k];
+    return acc;
+  };
+  AugmentedModel best = *m;
+  double best_cost = SumSquaredError(*m, s);
+  const int cols = nz + (o.fit_output_offset ? 1 : 0);
+  Eigen::MatrixXd jac(s.Count(), cols);
+  Eigen::VectorXd rhs(s.Count());
+  for (int it = 0; it < iterations; ++it) {
+    const Eigen::VectorXd z = phi * theta;
+    for (std::size_t r = 0; r < s.Count(); ++r) {
+      const double gp = slope(z(r));
+      jac.row(r).head(nz) = gp * phi.row(r);
+      if (o.fit_output_offset) jac(r, nz) = 1.0;
+      rhs(r) = (*s.y)[s.skip + r] - g(z(r)) + gp * z(r) - (o.fit_output_offset ? 0.0 : offset);
+    }
+    const Eigen::VectorXd th = jac.colPivHouseholderQr().solve(rhs);
+    if (!th.allFinite()) break;
+    theta = th.head(nz);
+    if (o.fit_output_offset) offset = th(nz);
+    AugmentedModel t = *m;
+    for (int j = 0; j < nb; ++j) t.nominal.linear.b[j] = theta(j);
+    t.output_offset = offset;
+    if (ninit > 0) t.initial_state.assign(theta.data() + nb, theta.data() + nz);
+    const double c = SumSquaredError(t, s);
+    if (std::isfinite(c) && c < best_cost) best = t, best_cost = c;
+  }
+  const bool changed = best_cost < SumSquaredError(*m, s);
+  *m = best;
+  return changed;
+}
+
 namespace {
 
 // ARX poles at the model's delay plus a delay block's dead time, on the input as the model's input map
@@ -823,7 +896,7 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   const Vec yhat = base.simulate(u);
   const auto grid = EffectGrid(effect, location, location == Location::kInput ? input : u,
                                location == Location::kOutput ? yhat : *s.y, zhat, base.nominal);
-  std::vector<std::pair<double, AugmentedModel>> scored;
+  std::vector<std::pair<double, AugmentedModel>> scored, resolved;
   auto wanted = [&](const Vec& p) {
     if (p.size() != 2 || (effect != Effect::kSaturation && effect != Effect::kStateSaturation)) return true;
     const bool lo = std::isfinite(p[0]), hi = std::isfinite(p[1]);
@@ -855,7 +928,14 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
         if (std::isfinite(cf)) scored.emplace_back(cf, fresh);
       }
     }
-    SolveNumerator(&m, s, o);
+    // A quantizer's grid points under a polynomial output map, where the least-squares re-solve does not
+    // apply, are also scored after a Gauss-Newton re-solve through the map: with the baseline's numerator,
+    // offset and initial state held, the shift of the quantized input that a grid offset makes is not
+    // absorbed, and the true step can rank far down the grid. The best 3 so re-solved are refined too.
+    if (!SolveNumerator(&m, s, o) && effect == Effect::kQuantization) {
+      AugmentedModel t = m;
+      if (SolveNumeratorThroughOutputMap(&t, s, o)) resolved.emplace_back(SumSquaredError(t, s), t);
+    }
     const double c = SumSquaredError(m, s);
     if (std::isfinite(c)) scored.emplace_back(c, m);
   }
@@ -898,7 +978,10 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   const bool jagged = effect == Effect::kQuantization || effect == Effect::kHysteresis || effect == Effect::kDeadzone;
   const bool misranked = jagged || effect == Effect::kRateLimit;
   const int refine = misranked ? 4 * o.keep_grid_points : o.keep_grid_points;
-  const int keep = std::min<int>(refine, static_cast<int>(scored.size()));
+  std::sort(resolved.begin(), resolved.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  if (resolved.size() > 3) resolved.resize(3);
+  for (auto& r : resolved) scored.insert(scored.begin(), std::move(r));
+  const int keep = std::min<int>(refine + static_cast<int>(resolved.size()), static_cast<int>(scored.size()));
   for (int i = 0; i < keep; ++i) {
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);

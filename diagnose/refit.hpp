@@ -84,6 +84,12 @@ void EstimateInitialState(AugmentedModel* model, const Segment& data, const Refi
 // an output or a state block.
 bool SolveNumerator(AugmentedModel* model, const Segment& data, const RefitOptions& options);
 
+// For fixed poles under a polynomial output map (input blocks only): Gauss–Newton on the numerator, the
+// output offset and the initial state (the map linearised about the current inner signal, `iterations`
+// least-squares solves); keeps the iterate of lowest cost. Returns whether the cost dropped; false (model
+// unchanged) for models without a polynomial output map or with output or state blocks.
+bool SolveNumeratorThroughOutputMap(AugmentedModel* model, const Segment& data, const RefitOptions& options,
+                                    int iterations = 3);
 // a_1..a_n of A(q) = prod (1 - r q^-1) over the roots r (complex roots in conjugate pairs).
 std::vector<double> DenominatorFromRoots(const std::vector<std::complex<double>>& roots);
 // Reflects roots of A(q) outside the unit circle inside it (keeps the model simulable).

@@ -362,6 +362,36 @@ TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt
   EXPECT_LT(r.sse, SumSquaredError(start, seg));
 }
 
+// Under a polynomial output map the output is not linear in the numerator, offset and initial state; the
+// Gauss-Newton re-solve through the map (poles held) recovers them from a start far off.
+TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Vec u(600);
+  double lp = 0.0;
+  for (auto& v : u) v = lp = 0.8 * lp + 0.4 * g(rng);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 0};
+  truth.nominal.output = StaticMap::Polynomial({1.0, 0.0, 0.3});
+  truth.output_offset = 0.3;
+  truth.initial_state = {1.5};
+  Vec y = truth.simulate(u);
+  for (auto& v : y) v += 0.01 * g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  AugmentedModel start = truth;
+  start.nominal.linear.b = {0.25, 0.05};
+  start.output_offset = 0.0;
+  start.initial_state = {0.0};
+  EXPECT_TRUE(SolveNumeratorThroughOutputMap(&start, seg, {}));
+  EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.01);
+  EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.01);
+  EXPECT_NEAR(start.output_offset, 0.3, 0.01);
+  EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
+  AugmentedModel identity = truth;  // no polynomial output map: not this re-solve's case
+  identity.nominal.output = StaticMap{};
+  EXPECT_FALSE(SolveNumeratorThroughOutputMap(&identity, seg, {}));
+}
+
 // Data from a mass–spring–damper whose "friction" pushes along the motion (a negative Coulomb level):
 // an unconstrained fit returns a negative coefficient; the diagnosis must never report one.
 TEST(Refit, FrictionIsNeverReportedWithANegativeLevel) {
