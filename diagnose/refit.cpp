@@ -978,8 +978,9 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   const bool jagged = effect == Effect::kQuantization || effect == Effect::kHysteresis || effect == Effect::kDeadzone;
   const bool misranked = jagged || effect == Effect::kRateLimit;
   const int refine = misranked ? 4 * o.keep_grid_points : o.keep_grid_points;
+  constexpr std::size_t kResolvedPointsRefined = 3;
   std::sort(resolved.begin(), resolved.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  if (resolved.size() > 3) resolved.resize(3);
+  if (resolved.size() > kResolvedPointsRefined) resolved.resize(kResolvedPointsRefined);
   for (auto& r : resolved) scored.insert(scored.begin(), std::move(r));
   const int keep = std::min<int>(refine + static_cast<int>(resolved.size()), static_cast<int>(scored.size()));
   for (int i = 0; i < keep; ++i) {
