@@ -169,23 +169,23 @@ bool HasStateBlock(const AugmentedModel& m) {
 
 }  // namespace
 
-// Exact least squares, for fixed poles, of the numerator, the offset and the initial state:
-// y ~ sum_j b_j f_{t-d-j} + c + sum_i s_i h_i(t), with f = x / A(q) and h_i the free response of 1/A(q)
-// to z_{-i} = 1. Only for models that are linear in these numbers (input blocks, identity output map).
-bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
-  if (m->nominal.output.kind != StaticMap::Kind::kIdentity || HasStateBlock(*m)) return false;
-  for (const auto& b : m->blocks)
-    if (b.location == Location::kOutput) return false;
+namespace {
+
+// The regressors of the numerator and the initial state, for fixed poles, over the segment's scored
+// samples: column j is f_{t-d-j} with f = x / A(q) (x the input map's output after the input blocks),
+// column nb + i the free response h_i of 1/A(q) to z_{-i} = 1 (when the initial state is estimated).
+// Empty when the segment is too short for them.
+Eigen::MatrixXd NumeratorAndInitialStateRegressors(const AugmentedModel& m, const Segment& s, const RefitOptions& o) {
   Vec x = *s.u;
-  for (const auto& b : m->blocks) x = ApplyInputBlock(b, x);
-  for (auto& v : x) v = m->nominal.input(v);
-  const auto& a = m->nominal.linear.a;
+  for (const auto& b : m.blocks) x = ApplyInputBlock(b, x);
+  for (auto& v : x) v = m.nominal.input(v);
+  const auto& a = m.nominal.linear.a;
   const Vec f = LinearBlock{a, {1.0}, 0}.simulate(x);
-  const int nb = static_cast<int>(m->nominal.linear.b.size());
+  const int nb = static_cast<int>(m.nominal.linear.b.size());
   const int ninit = o.estimate_initial_state ? static_cast<int>(a.size()) : 0;
-  const long d = m->nominal.linear.delay;
+  const long d = m.nominal.linear.delay;
   const std::size_t n = s.End();
-  if (s.Count() <= static_cast<std::size_t>(nb + ninit + 1)) return false;
+  if (s.Count() <= static_cast<std::size_t>(nb + ninit + 1)) return {};
   std::vector<Vec> h(ninit);
   for (int i = 0; i < ninit; ++i) {
     AugmentedModel free;
@@ -194,20 +194,42 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
     free.initial_state[i] = 1.0;
     free.simulate(Vec(n, 0.0), &h[i]);
   }
-  const int cols = nb + (o.fit_output_offset ? 1 : 0) + ninit;
-  Eigen::MatrixXd phi(s.Count(), cols);
-  Eigen::VectorXd yy(s.Count());
+  Eigen::MatrixXd phi(s.Count(), nb + ninit);
   for (std::size_t t = s.skip; t < n; ++t) {
     const std::size_t r = t - s.skip;
-    int c = 0;
     for (int j = 0; j < nb; ++j) {
       const long k = static_cast<long>(t) - d - j;
-      phi(r, c++) = k >= 0 ? f[k] : 0.0;
+      phi(r, j) = k >= 0 ? f[k] : 0.0;
     }
-    if (o.fit_output_offset) phi(r, c++) = 1.0;
-    for (int i = 0; i < ninit; ++i) phi(r, c++) = h[i][t];
-    yy(r) = (*s.y)[t];
+    for (int i = 0; i < ninit; ++i) phi(r, nb + i) = h[i][t];
   }
+  return phi;
+}
+
+bool HasOutputBlock(const AugmentedModel& m) {
+  for (const auto& b : m.blocks)
+    if (b.location == Location::kOutput) return true;
+  return false;
+}
+
+}  // namespace
+
+// Exact least squares, for fixed poles, of the numerator, the offset and the initial state:
+// y ~ sum_j b_j f_{t-d-j} + c + sum_i s_i h_i(t), with f = x / A(q) and h_i the free response of 1/A(q)
+// to z_{-i} = 1. Only for models that are linear in these numbers (input blocks, identity output map).
+bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  if (m->nominal.output.kind != StaticMap::Kind::kIdentity || HasStateBlock(*m) || HasOutputBlock(*m)) return false;
+  const Eigen::MatrixXd basis = NumeratorAndInitialStateRegressors(*m, s, o);
+  if (basis.size() == 0) return false;
+  const int nb = static_cast<int>(m->nominal.linear.b.size());
+  const int ninit = static_cast<int>(basis.cols()) - nb;
+  const int offset_cols = o.fit_output_offset ? 1 : 0;
+  Eigen::MatrixXd phi(s.Count(), nb + offset_cols + ninit);
+  phi.leftCols(nb) = basis.leftCols(nb);
+  if (o.fit_output_offset) phi.col(nb).setOnes();
+  phi.rightCols(ninit) = basis.rightCols(ninit);
+  Eigen::VectorXd yy(s.Count());
+  for (std::size_t r = 0; r < s.Count(); ++r) yy(r) = (*s.y)[s.skip + r];
   const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
   if (!th.allFinite()) return false;
   int c = 0;
@@ -219,39 +241,13 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
 
 bool SolveNumeratorThroughOutputMap(AugmentedModel* m, const Segment& s, const RefitOptions& o, int iterations) {
   const StaticMap& g = m->nominal.output;
-  if (g.kind != StaticMap::Kind::kPolynomial || HasStateBlock(*m)) return false;
-  for (const auto& b : m->blocks)
-    if (b.location == Location::kOutput) return false;
-  Vec x = *s.u;
-  for (const auto& b : m->blocks) x = ApplyInputBlock(b, x);
-  for (auto& v : x) v = m->nominal.input(v);
-  const auto& a = m->nominal.linear.a;
-  const Vec f = LinearBlock{a, {1.0}, 0}.simulate(x);
-  const int nb = static_cast<int>(m->nominal.linear.b.size());
-  const int ninit = o.estimate_initial_state ? static_cast<int>(a.size()) : 0;
-  const long d = m->nominal.linear.delay;
-  const std::size_t n = s.End();
-  if (s.Count() <= static_cast<std::size_t>(nb + ninit + 1)) return false;
-  std::vector<Vec> h(ninit);
-  for (int i = 0; i < ninit; ++i) {
-    AugmentedModel free;
-    free.nominal.linear = {a, {0.0}, 0};
-    free.initial_state.assign(ninit, 0.0);
-    free.initial_state[i] = 1.0;
-    free.simulate(Vec(n, 0.0), &h[i]);
-  }
+  if (g.kind != StaticMap::Kind::kPolynomial || HasStateBlock(*m) || HasOutputBlock(*m)) return false;
   // z = phi theta (theta: numerator, initial state), linear as under an identity output map.
-  const int nz = nb + ninit;
-  Eigen::MatrixXd phi(s.Count(), nz);
-  for (std::size_t t = s.skip; t < n; ++t) {
-    const std::size_t r = t - s.skip;
-    int c = 0;
-    for (int j = 0; j < nb; ++j) {
-      const long k = static_cast<long>(t) - d - j;
-      phi(r, c++) = k >= 0 ? f[k] : 0.0;
-    }
-    for (int i = 0; i < ninit; ++i) phi(r, c++) = h[i][t];
-  }
+  const Eigen::MatrixXd phi = NumeratorAndInitialStateRegressors(*m, s, o);
+  if (phi.size() == 0) return false;
+  const int nb = static_cast<int>(m->nominal.linear.b.size());
+  const int nz = static_cast<int>(phi.cols());
+  const int ninit = nz - nb;
   Eigen::VectorXd theta(nz);
   for (int j = 0; j < nb; ++j) theta(j) = m->nominal.linear.b[j];
   for (int i = 0; i < ninit; ++i) theta(nb + i) = i < static_cast<int>(m->initial_state.size()) ? m->initial_state[i] : 0.0;
