@@ -255,6 +255,15 @@ TEST(Refit, AThresholdBetweenTwoInputLevelsIsPlacedInsideTheInterval) {
   EXPECT_NEAR(r.model.blocks[0].params[1], 0.3, 0.03);
 }
 
+// n samples of first-order filtered white noise, v_t = pole v_{t-1} + gain e_t, drawn from rng.
+Vec FilteredNoise(std::mt19937_64& rng, std::size_t n, double pole, double gain) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  Vec u(n);
+  double lp = 0.0;
+  for (auto& v : u) v = lp = pole * lp + gain * g(rng);
+  return u;
+}
+
 // Random steps over a few levels (holds of 8-30 samples).
 Vec FewLevelSteps(std::mt19937_64& rng, const Vec& levels, std::size_t n) {
   std::uniform_int_distribution<int> pick(0, static_cast<int>(levels.size()) - 1), hold(8, 30);
@@ -342,10 +351,8 @@ TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
 // descend the staircase; the offset search puts it back within a tenth of a step.
 TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt) {
   std::mt19937_64 rng(3);
+  const Vec u = FilteredNoise(rng, 800, 0.9, 0.3);
   std::normal_distribution<double> g(0.0, 1.0);
-  Vec u(800);
-  double lp = 0.0;
-  for (auto& v : u) v = lp = 0.9 * lp + 0.3 * g(rng);
   AugmentedModel truth;
   truth.nominal.linear = {{-0.7}, {0.5}, 0};
   truth.blocks.push_back({Effect::kQuantization, Location::kOutput, {0.25, 0.0}, StateVariable::kPosition});
@@ -366,10 +373,8 @@ TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt
 // Gauss-Newton re-solve through the map (poles held) recovers them from a start far off.
 TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap) {
   std::mt19937_64 rng(5);
+  const Vec u = FilteredNoise(rng, 600, 0.8, 0.4);
   std::normal_distribution<double> g(0.0, 1.0);
-  Vec u(600);
-  double lp = 0.0;
-  for (auto& v : u) v = lp = 0.8 * lp + 0.4 * g(rng);
   AugmentedModel truth;
   truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 0};
   truth.nominal.output = StaticMap::Polynomial({1.0, 0.0, 0.3});
