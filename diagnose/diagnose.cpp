@@ -1034,24 +1034,45 @@ double StickSlipZ(const Context& c, const Finding& backlash, const Finding& stic
   return se > 0 ? (*share - 0.5) / se : 0.0;
 }
 
-// Both eligible: the one the prediction difference favours significantly (|z| >= 2) is ranked first; otherwise the ranking by penalised score stands and the evidence says it is a tie.
-void SettleStictionBacklash(const Context& c, std::vector<Finding>* fs) {
-  Finding *backlash = nullptr, *stiction = nullptr;
-  for (auto& f : *fs) {
-    if (!f.eligible || f.blocks.size() != 1) continue;
-    if (f.blocks.front().effect == Effect::kBacklash) backlash = &f;
-    if (f.blocks.front().effect == Effect::kStiction) stiction = &f;
+// The eligible finding with the one block `effect` (at `location`, when given); null when there is none.
+Finding* EligibleSingle(std::vector<Finding>* fs, Effect effect, std::optional<Location> location = std::nullopt) {
+  Finding* found = nullptr;
+  for (auto& f : *fs)
+    if (f.eligible && f.blocks.size() == 1 && f.blocks.front().effect == effect &&
+        (!location || f.blocks.front().location == *location))
+      found = &f;
+  return found;
+}
+
+// Which of two eligible findings the difference of their predictions on unseen data favours (StickSlipZ,
+// `a`'s residual regressed on it): the one favoured significantly (|z| >= 2) is ranked first, otherwise the
+// ranking by penalised score stands.
+enum class PairVerdict { kFirst, kSecond, kTie };
+PairVerdict RankByPredictionDifference(const Context& c, Finding* a, Finding* b, double* z, double* share) {
+  *z = StickSlipZ(c, *a, *b, share);
+  if (*z >= 2.0) {
+    b->score = std::max(b->score, a->score + 1e-9);
+    return PairVerdict::kSecond;
   }
+  if (*z <= -2.0) {
+    a->score = std::max(a->score, b->score + 1e-9);
+    return PairVerdict::kFirst;
+  }
+  return PairVerdict::kTie;
+}
+
+// Both eligible: ranked by RankByPredictionDifference, and the evidence says which way or that they tie.
+void SettleStictionBacklash(const Context& c, std::vector<Finding>* fs) {
+  Finding* backlash = EligibleSingle(fs, Effect::kBacklash);
+  Finding* stiction = EligibleSingle(fs, Effect::kStiction);
   if (!backlash || !stiction) return;
-  double share = 0.0;
-  const double z = StickSlipZ(c, *backlash, *stiction, &share);
+  double z = 0.0, share = 0.0;
+  const PairVerdict verdict = RankByPredictionDifference(c, backlash, stiction, &z, &share);
   const std::string where =
       fmt::format("in the difference between the stiction and backlash predictions on unseen data ({:.2f} of it is in the data)", share);
-  if (z >= 2.0) {
-    stiction->score = std::max(stiction->score, backlash->score + 1e-9);
+  if (verdict == PairVerdict::kSecond) {
     stiction->evidence += fmt::format("; stick-slip jump seen {}: stiction's error is lower (z = {:.1f})", where, z);
-  } else if (z <= -2.0) {
-    backlash->score = std::max(backlash->score, stiction->score + 1e-9);
+  } else if (verdict == PairVerdict::kFirst) {
     backlash->evidence += fmt::format("; no stick-slip jump {}: backlash's error is lower (z = {:.1f})", where, -z);
   } else {
     const std::string tie = fmt::format("; stiction and backlash tie {} (z = {:.1f})", where, z);
@@ -1068,23 +1089,17 @@ void SettleStictionBacklash(const Context& c, std::vector<Finding>* fs) {
 // by at least 2 standard errors, the one it favours is ranked first; otherwise the evidence of both says
 // they tie, and the ranking by penalised score stands.
 void SettleLimitLocations(const Context& c, std::vector<Finding>* fs, Effect ea, Location la, Effect eb, Location lb) {
-  Finding *a = nullptr, *b = nullptr;
-  for (auto& f : *fs) {
-    if (!f.eligible || f.blocks.size() != 1) continue;
-    if (f.blocks.front().effect == ea && f.blocks.front().location == la) a = &f;
-    if (f.blocks.front().effect == eb && f.blocks.front().location == lb) b = &f;
-  }
+  Finding* a = EligibleSingle(fs, ea, la);
+  Finding* b = EligibleSingle(fs, eb, lb);
   if (!a || !b) return;
-  double share = 0.0;
-  const double z = StickSlipZ(c, *a, *b, &share);
+  double z = 0.0, share = 0.0;
+  const PairVerdict verdict = RankByPredictionDifference(c, a, b, &z, &share);
   const std::string where = fmt::format("in the difference of the two predictions on unseen data (the {} residual's "
                                         "coefficient on it {:.2f}: 0 favours {}, 1 {})",
                                         a->Label(), share, a->Label(), b->Label());
-  if (z >= 2.0) {
-    b->score = std::max(b->score, a->score + 1e-9);
+  if (verdict == PairVerdict::kSecond) {
     b->evidence += fmt::format("; ranked above {} {} (z = {:.1f})", a->Label(), where, z);
-  } else if (z <= -2.0) {
-    a->score = std::max(a->score, b->score + 1e-9);
+  } else if (verdict == PairVerdict::kFirst) {
     a->evidence += fmt::format("; ranked above {} {} (z = {:.1f})", b->Label(), where, -z);
   } else {
     const std::string tie = fmt::format("; {} and {} tie {} (z = {:.1f})", a->Label(), b->Label(), where, z);
