@@ -84,10 +84,11 @@ void EstimateInitialState(AugmentedModel* model, const Segment& data, const Refi
 // an output or a state block.
 bool SolveNumerator(AugmentedModel* model, const Segment& data, const RefitOptions& options);
 
-// For fixed poles under a polynomial output map (input blocks only): Gauss–Newton on the numerator, the
-// output offset and the initial state (the map linearised about the current inner signal, `iterations`
-// least-squares solves); keeps the iterate of lowest cost. Returns whether the cost dropped; false (model
-// unchanged) for models without a polynomial output map or with output or state blocks.
+// For fixed poles under a polynomial output map, output dead bands and saturations, or both: Gauss–Newton
+// on the numerator, the output offset and the initial state (the map and the blocks linearised about the
+// current inner signal, `iterations` least-squares solves); keeps the iterate of lowest cost. Returns
+// whether the cost dropped; false (model unchanged) for models with neither, with a state block or with
+// another output block.
 bool SolveNumeratorThroughOutputMap(AugmentedModel* model, const Segment& data, const RefitOptions& options,
                                     int iterations = 3);
 // a_1..a_n of A(q) = prod (1 - r q^-1) over the roots r (complex roots in conjugate pairs).

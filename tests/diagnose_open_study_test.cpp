@@ -496,5 +496,17 @@ TEST(OpenStudy, InputQuantizerGridUnderAPolynomialOutputMapIsScoredAfterAReSolve
         << (fitted ? "fitted" : "given");
 }
 
+// An output dead band on a PRBS response (retired seed 1 400 461, linear:3,3,2, half-width 0.197, 9.6 noise
+// standard deviations): the output crosses the band quickly, so the cost has many local optima in the
+// band's centre and width; the refined grid points stopped at a centre 0.25 from the true one (2.3 times
+// the true band's fitting cost), validation found that fit 12 times the noise's mean square, a richer
+// linear nominal beat it there and replaced the baseline, and no effect was named. Scanned through the
+// band (numerator, offset and initial state re-solved), the fit reaches the true band.
+TEST(OpenStudy, OutputDeadBandCentreAndWidthAreScannedThroughTheBand) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kDeadzone, Location::kOutput, 1400461);
+  ASSERT_TRUE(Names(r, Effect::kDeadzone, Location::kOutput));
+  EXPECT_NEAR(r.verdict_blocks.front().params[0], 0.197, 0.01);
+}
+
 }  // namespace
 }  // namespace hw::diagnose
