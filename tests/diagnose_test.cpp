@@ -397,6 +397,35 @@ TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap
   EXPECT_FALSE(SolveNumeratorThroughOutputMap(&identity, seg, {}));
 }
 
+// An output dead band is not linear in the numerator, offset and initial state either: the re-solve
+// linearises through the band (slope 0 inside, 1 outside) and recovers them; an output quantizer is not
+// this re-solve's case.
+TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAnOutputDeadBand) {
+  std::mt19937_64 rng(6);
+  const Vec u = FilteredNoise(rng, 600, 0.8, 0.4);
+  std::normal_distribution<double> g(0.0, 1.0);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 0};
+  truth.blocks = {{Effect::kDeadzone, Location::kOutput, {0.3, 0.1}}};
+  truth.output_offset = 0.2;
+  truth.initial_state = {1.0};
+  Vec y = truth.simulate(u);
+  for (auto& v : y) v += 0.01 * g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  AugmentedModel start = truth;
+  start.nominal.linear.b = {0.25, 0.05};
+  start.output_offset = 0.0;
+  start.initial_state = {0.0};
+  EXPECT_TRUE(SolveNumeratorThroughOutputMap(&start, seg, {}, 6));
+  EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.02);
+  EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.02);
+  EXPECT_NEAR(start.output_offset, 0.2, 0.02);
+  EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
+  AugmentedModel quantized = truth;
+  quantized.blocks = {{Effect::kQuantization, Location::kOutput, {0.1, 0.0}}};
+  EXPECT_FALSE(SolveNumeratorThroughOutputMap(&quantized, seg, {}));
+}
+
 // Data from a mass–spring–damper whose "friction" pushes along the motion (a negative Coulomb level):
 // an unconstrained fit returns a negative coefficient; the diagnosis must never report one.
 TEST(Refit, FrictionIsNeverReportedWithANegativeLevel) {
