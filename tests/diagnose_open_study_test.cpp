@@ -508,5 +508,17 @@ TEST(OpenStudy, OutputDeadBandCentreAndWidthAreScannedThroughTheBand) {
   EXPECT_NEAR(r.verdict_blocks.front().params[0], 0.197, 0.01);
 }
 
+// A two-sided output saturation on PRBS (retired seed 1 400 193, hw:1,1,1,3,2, nominal given) whose lower
+// limit is reached only in the held-out tail and on validation: fitted on the fitting part, the upper limit
+// alone won; refitted on the whole recording with that one limit, validation was 1.27x the baseline's and the
+// state saturation (both limits) was named. Refitted on the whole recording with both limits as well, the
+// lower limit lowers the penalised cost there, validation confirms the output saturation, and the prediction
+// difference ranks it above the state saturation.
+TEST(OpenStudy, ALimitReachedOnlyAfterTheFittingPartIsFittedOnTheWholeRecording) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1400193);
+  ASSERT_TRUE(Names(r, Effect::kSaturation, Location::kOutput));
+  EXPECT_TRUE(std::isfinite(r.verdict_blocks.front().params[0]) && std::isfinite(r.verdict_blocks.front().params[1]));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
