@@ -223,16 +223,18 @@ bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t s
 // validation) started from it. The part that did not confirm is refitted from the other fit's numbers
 // and, for the whole recording, from the block's own grid as well; a new fit is kept only when it lowers
 // the cost on its own training data (never chosen by the part it is judged on).
-// A saturation-type block fitted with one limit on the fitting part may meet its other limit only later in
-// the recording (retired seed 1 400 193, PRBS: the output's lower limit is reached in the held-out tail and
-// on validation, not in the fitting part; the one-sided fit predicted validation 1.27x worse than the
-// baseline). Its refit on the whole recording from the grid is therefore also tried with both limits, and
-// the two are compared by their cost on the whole recording penalised for the effect parameters (FPE), so
-// that a second limit is kept only where it lowers the cost by more than a parameter's worth.
+// A saturation-type block's limits are chosen on the fitting part, which may not show them as the whole
+// recording does: the other limit may be reached only later (retired seed 1 400 193, PRBS: the output's
+// lower limit is reached in the held-out tail and on validation, not in the fitting part; the one-sided fit
+// predicted validation 1.27x worse than the baseline), or a second limit may clip a step level of the
+// fitting part by a hair (retired seed 1 400 479, steps: a spurious lower limit clipped validation's lower
+// levels, 25x the baseline's error). Its refit on the whole recording from the grid is therefore tried
+// with one upper, one lower and both limits, compared by their cost on the whole recording penalised for
+// the effect parameters (FPE), so that a second limit is kept only where it lowers that cost by more than
+// a parameter's worth.
 std::vector<LimitSides> WholeRecordingSides(Effect effect, LimitSides sides) {
-  const bool one_sided = sides == LimitSides::kUpper || sides == LimitSides::kLower;
-  if (one_sided && (effect == Effect::kSaturation || effect == Effect::kStateSaturation)) return {sides, LimitSides::kBoth};
-  return {sides};
+  if (effect != Effect::kSaturation && effect != Effect::kStateSaturation) return {sides};
+  return {LimitSides::kUpper, LimitSides::kLower, LimitSides::kBoth};
 }
 
 double PenalisedCost(const AugmentedModel& m, const Segment& s, int k) {
@@ -770,10 +772,14 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   if (!f.holdout.significant) ChooseTiedValueAmongFittingTies(c, ref, &f);
   if (f.holdout.significant && !f.validation.significant) ChooseTiedValueAmongIdentificationTies(c, ref, &f);
   ChooseStaticBandAmongTies(c, ref, &f);
+  // Both fits must describe a device: the one judged on the held-out tail and the one judged on validation
+  // and named (retired seed 1 400 479, steps: a narrow band in the middle of the output on the fitting part,
+  // refitted on the whole recording into a band centred at an output saturation's limit, i.e. a clamp).
   bool meaningful = true;
-  for (const auto& b : f.blocks)
-    if (b.location != Location::kState)
-      meaningful = meaningful && PhysicallyMeaningful(b, b.location == Location::kInput ? c.ident.u : c.ident.y, c.skip);
+  for (const auto* blocks : {&f.blocks, &f.model.blocks})
+    for (const auto& b : *blocks)
+      if (b.location != Location::kState)
+        meaningful = meaningful && PhysicallyMeaningful(b, b.location == Location::kInput ? c.ident.u : c.ident.y, c.skip);
   // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
   // the fitting part): a candidate that validation confirms may then pass the first test with the
   // recordings' roles swapped instead (refitted on the validation recording, scored on the whole

@@ -520,5 +520,30 @@ TEST(OpenStudy, ALimitReachedOnlyAfterTheFittingPartIsFittedOnTheWholeRecording)
   EXPECT_TRUE(std::isfinite(r.verdict_blocks.front().params[0]) && std::isfinite(r.verdict_blocks.front().params[1]));
 }
 
+// An upper output saturation on steps (retired seed 1 400 479, hw:2,3,1,3,1, nominal given): on the fitting
+// part a second, lower limit clipped the lowest step level by a hair and won the held-out score; validation,
+// with lower levels, was 25x the baseline's error and no effect was named. Refitted on the whole recording
+// with one and with both limits, the upper limit alone has the lower penalised cost there, and validation
+// confirms it.
+TEST(OpenStudy, ASecondLimitIsKeptOnlyWhereItLowersThePenalisedCostOfTheWholeRecording) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1400479);
+  ASSERT_TRUE(Names(r, Effect::kSaturation, Location::kOutput));
+  EXPECT_FALSE(std::isfinite(r.verdict_blocks.front().params[0]));
+}
+
+// The same recording with the output dead band as the only candidate: fitted on the fitting part it is a
+// narrow band in the middle of the output, refitted on the whole recording a band centred at the
+// saturation's limit (a clamp, not a dead band). The named fit must describe a device too.
+TEST(OpenStudy, TheFitOnTheWholeRecordingMustBePhysicallyMeaningfulToo) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kSaturation;
+  so.location = Location::kOutput;
+  so.seed = 1400479;
+  DiagnoseOptions o;
+  o.candidates = {{Effect::kDeadzone, Location::kOutput}};
+  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/false, o).report;
+  EXPECT_EQ(r.verdict, Effect::kNone) << r.message;
+}
+
 }  // namespace
 }  // namespace hw::diagnose
