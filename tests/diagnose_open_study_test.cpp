@@ -436,6 +436,32 @@ TEST(OpenStudy, InputMapShapeLeftFreeByATwoLevelInputIsJudgedOnValidation) {
                     Location::kOutput));
 }
 
+// The same freedom under any block the two-level input passes through unchanged (development seeds of
+// 1 400 001-1 400 500, PRBS, nominal fitted): an output dead band (1 400 138, hw:3,3,3,1,2) moved the
+// cubic's coefficients from (-0.476, -0.075) to (-0.437, -0.105), held-out 0.446x, validation 0.908x (not
+// significant). With a dead time of 2 and 3 numerator terms, no initial state takes up the constant moved
+// out of the map at the first samples exactly; the tie agrees with the model to a hundredth of the residual
+// RMS there and exactly afterwards, and validation confirms the band (0.824x).
+TEST(OpenStudy, InputMapShapeUnderAnOutputDeadBandIsJudgedOnValidation) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kDeadzone;
+  so.location = Location::kOutput;
+  so.seed = 1400138;
+  EXPECT_TRUE(Names(DiagnoseOpenScenario(so, /*fitted=*/true).report, Effect::kDeadzone, Location::kOutput));
+}
+
+// A state saturation under a fitted cubic input map (development seed 1 400 172, PRBS, hw:3,1,3,1,1): the
+// constant moved out of the map shifts the state by its steady-state response, and the limit shifted by
+// as much gives the same prediction. The fit had moved the cubic's second coefficient from 0.206 to
+// 0.282 (held-out 0.323x, validation 1.25x); with the baseline's shape validation confirms it (0.857x).
+TEST(OpenStudy, InputMapShapeUnderAStateSaturationIsJudgedOnValidation) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kStateSaturation;
+  so.location = Location::kState;
+  so.seed = 1400172;
+  EXPECT_TRUE(Names(DiagnoseOpenScenario(so, /*fitted=*/true).report, Effect::kStateSaturation, Location::kState));
+}
+
 // An input quantizer under a cubic input map on steps (retired seed 1 300 078, hw:3,3,3,1,2): the fitted
 // grid (step 0.379, offset -0.1 step) and the true one (0.398, offset 0) put every identification sample
 // on the same level index, and the cubic composed with the affine change between the grids predicts the
