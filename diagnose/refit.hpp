@@ -101,7 +101,8 @@ bool FitArx(const std::vector<double>& x, const std::vector<double>& y, int na, 
             std::size_t end, bool with_constant, std::vector<double>* a, std::vector<double>* b, double* constant);
 
 // Whether the polynomial static maps are monotone over the signals they see for input u (the input map
-// over u's range, the output map over the simulated z's range). Identity maps are monotone.
+// over the range of u after the input blocks, the output map over the simulated z's range). Identity maps
+// are monotone.
 bool MapsMonotone(const AugmentedModel& m, const std::vector<double>& u);
 
 // Number of effect parameters of the blocks that are estimated (finite).

@@ -296,6 +296,43 @@ TEST(Refit, ASaturationBetweenTwoInputLevelsIsFoundFromTheGapBetweenThem) {
   EXPECT_LT(r.sse, 2.0 * u.size() * 0.01 * 0.01);
 }
 
+// The input map must be monotone where it acts: after an input limit, not out to the unclipped input's
+// extremes. A map folding back below the limit is never seen, and judged over the whole input it would
+// refuse every step of a fit that puts the limit where the map had bent to mimic it.
+TEST(Refit, AnInputMapIsJudgedMonotoneOnTheInputAfterTheInputBlocks) {
+  Vec u;
+  for (int t = 0; t < 200; ++t) u.push_back(2.0 * std::sin(0.07 * t));
+  AugmentedModel m;
+  m.nominal.linear = {{-0.5}, {0.5}, 0};
+  m.nominal.input = StaticMap::Polynomial({1.0, 0.4});  // slope 1 + 0.8 v: folds back below v = -1.25
+  EXPECT_FALSE(MapsMonotone(m, u));
+  m.blocks.push_back({Effect::kSaturation, Location::kInput, {-1.0, HUGE_VAL}, StateVariable::kPosition});
+  EXPECT_TRUE(MapsMonotone(m, u));
+}
+
+// The consequence in a fit: the nominal refitted without the limit bends its cubic input map to zero slope
+// at the lowest input (as far as monotone allows) to mimic the clipping. With the limit added, the map
+// must straighten where the limit now clips; judged over the unclipped input, every step that does so
+// was refused and the limit stayed where the grid put it (1.3 instead of 1.0, 2.8x the noise's cost).
+TEST(Refit, AnInputLimitIsFoundUnderAnInputMapBentToMimicIt) {
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const Vec u = FilteredNoise(rng, 700, 0.85, 0.5);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.6}, {0.25, 0.12}, 0};
+  truth.nominal.input = StaticMap::Polynomial({1.0, 0.15, 0.03});
+  truth.blocks.push_back({Effect::kSaturation, Location::kInput, {-1.0, HUGE_VAL}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  for (auto& v : y) v += 0.015 * g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
+  const RefitResult r = AddBlock(nominal, Effect::kSaturation, Location::kInput, StateVariable::kPosition, seg, {},
+                                 LimitSides::kLower);
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_NEAR(r.model.blocks[0].params[0], -1.0, 0.03);
+  EXPECT_LT(r.sse, 1.3 * u.size() * 0.015 * 0.015);
+}
+
 // On a two-level input (PRBS) every quantile of the input is one of its two levels: a limit there clips
 // nothing, and no finite limit was tried at all (the fit returned no block). A limit that moves the low
 // level inwards starts between the two levels and is refined to the truth. The nominal's maps are held
@@ -344,6 +381,33 @@ TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
   EXPECT_NEAR(r.model.blocks[0].params[0], 0.4, 0.08);
   EXPECT_NEAR(r.model.blocks[0].params[1], 0.1, 0.04);
   EXPECT_LT(r.sse, 2.0 * u.size() * 0.005 * 0.005);
+}
+
+// The same under a cubic output map, where the numerator, offset and initial state are not linear in the
+// output: every band pair tried is scored with them re-solved through the map. Held at the values that
+// fitted the backlash start, the true pair costs more than a poorer one, and the fit stays with the
+// kinetic band near the play and no jump worth naming.
+TEST(Refit, StictionBandsAreSearchedThroughAPolynomialOutputMap) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> level(-1.5, 1.5);
+  std::uniform_int_distribution<int> hold(20, 60);
+  Vec u;
+  while (u.size() < 600) u.insert(u.end(), hold(rng), level(rng));
+  u.resize(600);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.9, 0.8}, {1.0, -0.13}, 0};
+  truth.nominal.output = StaticMap::Polynomial({1.0, 0.17, 0.11});
+  truth.blocks.push_back({Effect::kStiction, Location::kInput, {0.45, 0.18}, StateVariable::kPosition});
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, 0.03);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
+  const RefitResult r = AddBlock(nominal, Effect::kStiction, Location::kInput, StateVariable::kPosition, seg, {});
+  ASSERT_EQ(r.model.blocks.size(), 1u);
+  EXPECT_NEAR(r.model.blocks[0].params[1], 0.18, 0.02);
+  EXPECT_GT(r.model.blocks[0].params[0], 0.3);
+  EXPECT_LT(r.sse, 1.2 * u.size() * 0.03 * 0.03);  // the backlash-side optimum costs 1.8x the noise
 }
 
 // Under an output quantizer the output offset moves the prediction by whole steps: started a third of a
