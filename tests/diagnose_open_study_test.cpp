@@ -220,13 +220,19 @@ OpenDiagnosis DiagnoseOpenScenario(const OpenScenarioOptions& so, bool fitted, D
   return d;
 }
 
-// The report on one scenario (effect, location, seed) diagnosed with its true nominal given.
-DiagnoseReport DiagnoseWithNominalGiven(Effect effect, Location location, unsigned seed) {
+// The report on one scenario (effect, location, seed) diagnosed with its true nominal given, or fitted.
+DiagnoseReport DiagnoseScenario(Effect effect, Location location, unsigned seed, bool fitted) {
   OpenScenarioOptions so;
   so.effect = effect;
   so.location = location;
   so.seed = seed;
-  return DiagnoseOpenScenario(so, /*fitted=*/false).report;
+  return DiagnoseOpenScenario(so, fitted).report;
+}
+DiagnoseReport DiagnoseWithNominalGiven(Effect effect, Location location, unsigned seed) {
+  return DiagnoseScenario(effect, location, seed, /*fitted=*/false);
+}
+DiagnoseReport DiagnoseWithNominalFitted(Effect effect, Location location, unsigned seed) {
+  return DiagnoseScenario(effect, location, seed, /*fitted=*/true);
 }
 
 // Whether the report names `effect` at `location` (its message otherwise).
@@ -396,11 +402,7 @@ TEST(OpenStudy, DeadBandInsideASkewedSignalIsMeaningful) {
 // acts, within one batch, which gives the batch z exactly 1; rounding put it below 1, the block seemed
 // not needed and the fit was called failed (verdict none).
 TEST(NominalStatus, ALimitActingWithinOneBatchIsNeeded) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kSaturation;
-  so.location = Location::kOutput;
-  so.seed = 1100049;
-  const DiagnoseReport r = DiagnoseOpenScenario(so, /*fitted=*/true).report;
+  const DiagnoseReport r = DiagnoseWithNominalFitted(Effect::kSaturation, Location::kOutput, 1100049);
   EXPECT_TRUE(Names(r, Effect::kSaturation, Location::kOutput));
   EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
 }
@@ -443,11 +445,8 @@ TEST(OpenStudy, InputMapShapeLeftFreeByATwoLevelInputIsJudgedOnValidation) {
 // out of the map at the first samples exactly; the tie agrees with the model to a hundredth of the residual
 // RMS there and exactly afterwards, and validation confirms the band (0.824x).
 TEST(OpenStudy, InputMapShapeUnderAnOutputDeadBandIsJudgedOnValidation) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kDeadzone;
-  so.location = Location::kOutput;
-  so.seed = 1400138;
-  EXPECT_TRUE(Names(DiagnoseOpenScenario(so, /*fitted=*/true).report, Effect::kDeadzone, Location::kOutput));
+  EXPECT_TRUE(Names(DiagnoseWithNominalFitted(Effect::kDeadzone, Location::kOutput, 1400138), Effect::kDeadzone,
+                    Location::kOutput));
 }
 
 // A state saturation under a fitted cubic input map (development seed 1 400 172, PRBS, hw:3,1,3,1,1): the
@@ -455,11 +454,8 @@ TEST(OpenStudy, InputMapShapeUnderAnOutputDeadBandIsJudgedOnValidation) {
 // as much gives the same prediction. The fit had moved the cubic's second coefficient from 0.206 to
 // 0.282 (held-out 0.323x, validation 1.25x); with the baseline's shape validation confirms it (0.857x).
 TEST(OpenStudy, InputMapShapeUnderAStateSaturationIsJudgedOnValidation) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kStateSaturation;
-  so.location = Location::kState;
-  so.seed = 1400172;
-  EXPECT_TRUE(Names(DiagnoseOpenScenario(so, /*fitted=*/true).report, Effect::kStateSaturation, Location::kState));
+  EXPECT_TRUE(Names(DiagnoseWithNominalFitted(Effect::kStateSaturation, Location::kState, 1400172),
+                    Effect::kStateSaturation, Location::kState));
 }
 
 // An input quantizer under a cubic input map on steps (retired seed 1 300 078, hw:3,3,3,1,2): the fitted

@@ -273,6 +273,16 @@ Vec FewLevelSteps(std::mt19937_64& rng, const Vec& levels, std::size_t n) {
   return u;
 }
 
+// Random steps of uniformly drawn levels in [lo, hi], each held for a uniform hold_min-hold_max samples.
+Vec UniformSteps(std::mt19937_64& rng, std::size_t n, double lo, double hi, int hold_min, int hold_max) {
+  std::uniform_real_distribution<double> level(lo, hi);
+  std::uniform_int_distribution<int> hold(hold_min, hold_max);
+  Vec u;
+  while (u.size() < n) u.insert(u.end(), hold(rng), level(rng));
+  u.resize(n);
+  return u;
+}
+
 // A saturation whose limit lies between the two top levels of a step input: every quantile of the
 // input is a level, and a limit at a level clips nothing of it. With a nominal fitted without the block
 // (its cubic output map absorbed part of the clipping, and no numerator can be re-solved under it), the
@@ -363,11 +373,7 @@ TEST(Refit, ASaturationOfATwoLevelInputIsFound) {
 // play between the two, and only a joint move of both bands (static up, kinetic down) opens the jump.
 TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
   std::mt19937_64 rng(8);
-  std::uniform_real_distribution<double> level(-1.0, 1.0);
-  std::uniform_int_distribution<int> hold(8, 30);
-  Vec u;
-  while (u.size() < 1000) u.insert(u.end(), hold(rng), level(rng));
-  u.resize(1000);
+  const Vec u = UniformSteps(rng, 1000, -1.0, 1.0, 8, 30);
   AugmentedModel truth;
   truth.nominal.linear = {{-0.8}, {0.2}, 0};
   truth.blocks.push_back({Effect::kStiction, Location::kInput, {0.4, 0.1}, StateVariable::kPosition});
@@ -389,11 +395,7 @@ TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
 // kinetic band near the play and no jump worth naming.
 TEST(Refit, StictionBandsAreSearchedThroughAPolynomialOutputMap) {
   std::mt19937_64 rng(4);
-  std::uniform_real_distribution<double> level(-1.5, 1.5);
-  std::uniform_int_distribution<int> hold(20, 60);
-  Vec u;
-  while (u.size() < 600) u.insert(u.end(), hold(rng), level(rng));
-  u.resize(600);
+  const Vec u = UniformSteps(rng, 600, -1.5, 1.5, 20, 60);
   AugmentedModel truth;
   truth.nominal.linear = {{-0.9, 0.8}, {1.0, -0.13}, 0};
   truth.nominal.output = StaticMap::Polynomial({1.0, 0.17, 0.11});
