@@ -218,11 +218,6 @@ bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t s
   return b.params[0] < Median(mag) && central;
 }
 
-// When only one of the two tests confirms a candidate, its two fits may sit in different optima: the
-// fit on the fitting part (judged on the held-out tail) and its refit on the whole recording (judged on
-// validation) started from it. The part that did not confirm is refitted from the other fit's numbers
-// and, for the whole recording, from the block's own grid as well; a new fit is kept only when it lowers
-// the cost on its own training data (never chosen by the part it is judged on).
 // A saturation-type block's limits are chosen on the fitting part, which may not show them as the whole
 // recording does: the other limit may be reached only later (retired seed 1 400 193, PRBS: the output's
 // lower limit is reached in the held-out tail and on validation, not in the fitting part; the one-sided fit
@@ -242,6 +237,12 @@ double PenalisedCost(const AugmentedModel& m, const Segment& s, int k) {
   return SumSquaredError(m, s) * (n + k) / std::max(n - k, 1.0);
 }
 
+// When only one of the two tests confirms a candidate, its two fits may sit in different optima: the
+// fit on the fitting part (judged on the held-out tail) and its refit on the whole recording (judged on
+// validation) started from it. The part that did not confirm is refitted from the other fit's numbers
+// and, for the whole recording, from the block's own grid as well; a new fit is kept only when it lowers
+// the cost on its own training data (never chosen by the part it is judged on), penalised for the effect
+// parameters where the limit sides differ (WholeRecordingSides).
 void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Location location, LimitSides sides,
                    Finding* f) {
   if (!f->holdout.significant) {
@@ -559,6 +560,13 @@ bool BestTiedValue(const Context& c, AugmentedModel* model, const Segment& agree
   return true;
 }
 
+AugmentedModel WithoutOutputBlocks(AugmentedModel m) {
+  m.blocks.erase(std::remove_if(m.blocks.begin(), m.blocks.end(),
+                                [](const EffectBlock& b) { return b.location == Location::kOutput; }),
+                 m.blocks.end());
+  return m;
+}
+
 // A polynomial input map is seen only through its values at the levels its argument takes: on a
 // two-level input (PRBS) every map gives the same prediction once the numerator is scaled and the output
 // offset shifted to match its two values, so the identification recording leaves the map's shape free,
@@ -573,20 +581,6 @@ bool BestTiedValue(const Context& c, AugmentedModel* model, const Segment& agree
 // predicts the identification recording alike. None when a state block cannot follow the constant
 // (StateBlocksFollowShift), the output map is not the identity (the offset cannot absorb the constant
 // there), or the input map is not a polynomial.
-Vec InputMapArgument(const AugmentedModel& m, const Vec& u) {
-  Vec v = u;
-  for (const auto& b : m.blocks)
-    if (b.location == Location::kInput) v = ApplyInputBlock(b, v);
-  return v;
-}
-
-AugmentedModel WithoutOutputBlocks(AugmentedModel m) {
-  m.blocks.erase(std::remove_if(m.blocks.begin(), m.blocks.end(),
-                                [](const EffectBlock& b) { return b.location == Location::kOutput; }),
-                 m.blocks.end());
-  return m;
-}
-
 // The constant taken out of the input map moves the state (the linear block's output) by a constant, its
 // steady-state response: a state limit moves with it and a friction acting on the state's increments
 // does not see it, so those blocks follow exactly (limits shifted by the same constant); a cubic
@@ -611,7 +605,7 @@ std::optional<AugmentedModel> WithInputMapShapeOf(const Context& c, const Augmen
       (shape.kind != StaticMap::Kind::kPolynomial && shape.kind != StaticMap::Kind::kIdentity))
     return std::nullopt;
   if (!StateBlocksFollowShift(m)) return std::nullopt;
-  const Vec v = InputMapArgument(m, c.ident.u);
+  const Vec v = m.AfterInputBlocks(c.ident.u);
   double sw = 0, sg = 0, sf = 0, sgg = 0, sgf = 0;
   for (double x : v) {
     const double g = shape(x), h = m.nominal.input(x);

@@ -435,11 +435,16 @@ AugmentedModel AugmentedModel::WithoutBlocks() const {
   return m;
 }
 
-bool AugmentedModel::simulate(const std::vector<double>& u, std::vector<double>* y) const {
-  const std::size_t n = u.size();
+std::vector<double> AugmentedModel::AfterInputBlocks(const std::vector<double>& u) const {
   std::vector<double> x = u;
   for (const auto& b : blocks)
     if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
+  return x;
+}
+
+bool AugmentedModel::simulate(const std::vector<double>& u, std::vector<double>* y) const {
+  const std::size_t n = u.size();
+  std::vector<double> x = AfterInputBlocks(u);
   for (auto& v : x) v = nominal.input(v);
   const auto& a = nominal.linear.a;
   const auto& bb = nominal.linear.b;

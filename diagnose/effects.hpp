@@ -107,6 +107,8 @@ struct AugmentedModel {
   // diverges, so that an optimiser sees a bad but finite cost.
   bool simulate(const std::vector<double>& u, std::vector<double>* y) const;
   std::vector<double> simulate(const std::vector<double>& u) const;
+  // Input u after the input-location blocks, in order: the signal the input map sees.
+  std::vector<double> AfterInputBlocks(const std::vector<double>& u) const;
   AugmentedModel WithoutBlocks() const;  // same numbers, blocks switched off
   nlohmann::json to_json() const;
   // Reads a plain model JSON or an augmented one (docs/input_output.md "Model JSON" + the keys above). Unknown or

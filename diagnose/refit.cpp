@@ -176,9 +176,7 @@ namespace {
 // column nb + i the free response h_i of 1/A(q) to z_{-i} = 1 (when the initial state is estimated).
 // Empty when the segment is too short for them.
 Eigen::MatrixXd NumeratorAndInitialStateRegressors(const AugmentedModel& m, const Segment& s, const RefitOptions& o) {
-  Vec x = *s.u;
-  for (const auto& b : m.blocks)
-    if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
+  Vec x = m.AfterInputBlocks(*s.u);
   for (auto& v : x) v = m.nominal.input(v);
   const auto& a = m.nominal.linear.a;
   const Vec f = LinearBlock{a, {1.0}, 0}.simulate(x);
@@ -329,9 +327,7 @@ namespace {
 bool FreshPolesForDelay(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
   const int na = static_cast<int>(m->nominal.linear.a.size()), nb = static_cast<int>(m->nominal.linear.b.size());
   if (na == 0) return false;
-  Vec x = *s.u;
-  for (const auto& b : m->blocks)
-    if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
+  Vec x = m->AfterInputBlocks(*s.u);
   for (auto& v : x) v = m->nominal.input(v);
   Vec a, b;
   double c = 0.0;
@@ -813,9 +809,7 @@ bool RefitOptions::IsValid(std::string* error) const {
 // added refused, and the limit stayed where the grid put it).
 bool MapsMonotone(const AugmentedModel& m, const Vec& u) {
   if (u.empty()) return true;
-  Vec x = u;
-  for (const auto& b : m.blocks)
-    if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
+  const Vec x = m.AfterInputBlocks(u);
   const auto [xlo, xhi] = std::minmax_element(x.begin(), x.end());
   if (!MonotoneOn(m.nominal.input, *xlo, *xhi)) return false;
   if (m.nominal.output.kind != StaticMap::Kind::kPolynomial) return true;
@@ -966,9 +960,7 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   const Vec& u = *s.u;
   // The signal the block acts on, from the current model: the state for state blocks.
   const Vec zhat = InnerState(base, u);
-  Vec input = u;  // a second input block acts after the first one
-  for (const auto& b : base.blocks)
-    if (b.location == Location::kInput) input = ApplyInputBlock(b, input);
+  const Vec input = base.AfterInputBlocks(u);  // a second input block acts after the first one
   const Vec yhat = base.simulate(u);
   const auto grid = EffectGrid(effect, location, location == Location::kInput ? input : u,
                                location == Location::kOutput ? yhat : *s.y, zhat, base.nominal);
