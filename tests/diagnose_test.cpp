@@ -283,6 +283,18 @@ Vec UniformSteps(std::mt19937_64& rng, std::size_t n, double lo, double hi, int 
   return u;
 }
 
+// A stiction block added to the truth's nominal (refitted without it) on the truth's output for input u
+// with white noise of standard deviation `noise` drawn from rng.
+RefitResult StictionAddedToNoisyRecording(const AugmentedModel& truth, const Vec& u, double noise,
+                                          std::mt19937_64& rng) {
+  Vec y = truth.simulate(u);
+  std::normal_distribution<double> g(0.0, noise);
+  for (auto& v : y) v += g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
+  return AddBlock(nominal, Effect::kStiction, Location::kInput, StateVariable::kPosition, seg, {});
+}
+
 // A saturation whose limit lies between the two top levels of a step input: every quantile of the
 // input is a level, and a limit at a level clips nothing of it. With a nominal fitted without the block
 // (its cubic output map absorbed part of the clipping, and no numerator can be re-solved under it), the
@@ -377,12 +389,7 @@ TEST(Refit, StictionBandsAreSearchedTogetherFromTheBacklashStart) {
   AugmentedModel truth;
   truth.nominal.linear = {{-0.8}, {0.2}, 0};
   truth.blocks.push_back({Effect::kStiction, Location::kInput, {0.4, 0.1}, StateVariable::kPosition});
-  Vec y = truth.simulate(u);
-  std::normal_distribution<double> g(0.0, 0.005);
-  for (auto& v : y) v += g(rng);
-  const Segment seg{&u, &y, 0, 0};
-  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
-  const RefitResult r = AddBlock(nominal, Effect::kStiction, Location::kInput, StateVariable::kPosition, seg, {});
+  const RefitResult r = StictionAddedToNoisyRecording(truth, u, 0.005, rng);
   ASSERT_EQ(r.model.blocks.size(), 1u);
   EXPECT_NEAR(r.model.blocks[0].params[0], 0.4, 0.08);
   EXPECT_NEAR(r.model.blocks[0].params[1], 0.1, 0.04);
@@ -400,12 +407,7 @@ TEST(Refit, StictionBandsAreSearchedThroughAPolynomialOutputMap) {
   truth.nominal.linear = {{-0.9, 0.8}, {1.0, -0.13}, 0};
   truth.nominal.output = StaticMap::Polynomial({1.0, 0.17, 0.11});
   truth.blocks.push_back({Effect::kStiction, Location::kInput, {0.45, 0.18}, StateVariable::kPosition});
-  Vec y = truth.simulate(u);
-  std::normal_distribution<double> g(0.0, 0.03);
-  for (auto& v : y) v += g(rng);
-  const Segment seg{&u, &y, 0, 0};
-  const AugmentedModel nominal = RefitModel(truth.WithoutBlocks(), seg, {}).model;
-  const RefitResult r = AddBlock(nominal, Effect::kStiction, Location::kInput, StateVariable::kPosition, seg, {});
+  const RefitResult r = StictionAddedToNoisyRecording(truth, u, 0.03, rng);
   ASSERT_EQ(r.model.blocks.size(), 1u);
   EXPECT_NEAR(r.model.blocks[0].params[1], 0.18, 0.02);
   EXPECT_GT(r.model.blocks[0].params[0], 0.3);
