@@ -439,28 +439,42 @@ TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt
 
 // Under a polynomial output map the output is not linear in the numerator, offset and initial state; the
 // Gauss-Newton re-solve through the map (poles held) recovers them from a start far off.
-TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap) {
-  std::mt19937_64 rng(5);
-  const Vec u = FilteredNoise(rng, 600, 0.8, 0.4);
+// The set-up the re-solves through an output map share: a first-order system (b = 0.4, 0.2) driven by filtered
+// noise with noise 0.01, and a start whose numerator, offset and initial state are far off.
+struct ReSolveCase {
+  Vec u, y;
+  AugmentedModel start;
+};
+
+ReSolveCase ReSolveCaseFor(AugmentedModel truth, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  ReSolveCase c;
+  c.u = FilteredNoise(rng, 600, 0.8, 0.4);
   std::normal_distribution<double> g(0.0, 1.0);
-  AugmentedModel truth;
   truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 0};
+  c.y = truth.simulate(c.u);
+  for (auto& v : c.y) v += 0.01 * g(rng);
+  c.start = truth;
+  c.start.nominal.linear.b = {0.25, 0.05};
+  c.start.output_offset = 0.0;
+  c.start.initial_state = {0.0};
+  return c;
+}
+
+TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap) {
+  AugmentedModel truth;
   truth.nominal.output = StaticMap::Polynomial({1.0, 0.0, 0.3});
   truth.output_offset = 0.3;
   truth.initial_state = {1.5};
-  Vec y = truth.simulate(u);
-  for (auto& v : y) v += 0.01 * g(rng);
-  const Segment seg{&u, &y, 0, 0};
-  AugmentedModel start = truth;
-  start.nominal.linear.b = {0.25, 0.05};
-  start.output_offset = 0.0;
-  start.initial_state = {0.0};
+  ReSolveCase c = ReSolveCaseFor(truth, 5);
+  const Segment seg{&c.u, &c.y, 0, 0};
+  AugmentedModel& start = c.start;
   EXPECT_TRUE(SolveNumeratorThroughOutputMap(&start, seg, {}));
   EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.01);
   EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.01);
   EXPECT_NEAR(start.output_offset, 0.3, 0.01);
   EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
-  AugmentedModel identity = truth;  // no polynomial output map: not this re-solve's case
+  AugmentedModel identity = start;  // no polynomial output map: not this re-solve's case
   identity.nominal.output = StaticMap{};
   EXPECT_FALSE(SolveNumeratorThroughOutputMap(&identity, seg, {}));
 }
@@ -469,27 +483,19 @@ TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap
 // linearises through the band (slope 0 inside, 1 outside) and recovers them; an output quantizer is not
 // this re-solve's case.
 TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAnOutputDeadBand) {
-  std::mt19937_64 rng(6);
-  const Vec u = FilteredNoise(rng, 600, 0.8, 0.4);
-  std::normal_distribution<double> g(0.0, 1.0);
   AugmentedModel truth;
-  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 0};
   truth.blocks = {{Effect::kDeadzone, Location::kOutput, {0.3, 0.1}}};
   truth.output_offset = 0.2;
   truth.initial_state = {1.0};
-  Vec y = truth.simulate(u);
-  for (auto& v : y) v += 0.01 * g(rng);
-  const Segment seg{&u, &y, 0, 0};
-  AugmentedModel start = truth;
-  start.nominal.linear.b = {0.25, 0.05};
-  start.output_offset = 0.0;
-  start.initial_state = {0.0};
+  ReSolveCase c = ReSolveCaseFor(truth, 6);
+  const Segment seg{&c.u, &c.y, 0, 0};
+  AugmentedModel& start = c.start;
   EXPECT_TRUE(SolveNumeratorThroughOutputMap(&start, seg, {}, 6));
   EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.02);
   EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.02);
   EXPECT_NEAR(start.output_offset, 0.2, 0.02);
   EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
-  AugmentedModel quantized = truth;
+  AugmentedModel quantized = start;
   quantized.blocks = {{Effect::kQuantization, Location::kOutput, {0.1, 0.0}}};
   EXPECT_FALSE(SolveNumeratorThroughOutputMap(&quantized, seg, {}));
 }
