@@ -189,6 +189,9 @@ double ContributionRms(const AugmentedModel& m, const HwModel& lin, const Vec& u
   return Rms(w);
 }
 
+// A size the bisection below ends under (of 1, its start) is a search that found no size at all.
+constexpr double kVanishingEffectSize = 1e-6;
+
 // The effect strength whose contribution on u has RMS `target` (bisection; delay is not scalable).
 EffectBlock SizeEffect(const EffectShape& shape, const HwModel& lin, const Vec& u, double target) {
   const Vec wl = AugmentedModel{lin, {}, 0.0, {}}.simulate(u);
@@ -214,6 +217,9 @@ EffectBlock SizeEffect(const EffectShape& shape, const HwModel& lin, const Vec& 
       (rms(mid) < target ? lo : hi) = mid;
     }
     s = 0.5 * (lo + hi);
+    // Any size of it moves the output by more than the target (a stick-slip cycle in closed loop): the
+    // search ends at a vanishing size, which is no effect at all; the draw is not usable.
+    if (s < kVanishingEffectSize) throw InputError("open scenario: the effect cannot be sized to its target");
   }
   return shape.Block(s, lv, du, force, zr);
 }
@@ -398,6 +404,9 @@ OpenScenario DrawOpenScenario(const OpenScenarioOptions& o, Rng& rng) {
 
 }  // namespace
 
+// Draws tried per seed before the seed is reported unusable (closed-loop stiction often cannot be sized).
+constexpr int kMaxDrawsPerSeed = 24;
+
 OpenScenario MakeOpenScenario(const OpenScenarioOptions& o) {
   std::string err;
   if (!o.IsValid(&err)) throw InputError("open scenario: " + err);
@@ -407,7 +416,7 @@ OpenScenario MakeOpenScenario(const OpenScenarioOptions& o) {
     try {
       return DrawOpenScenario(o, rng);
     } catch (const InputError&) {
-      if (attempt == 8) throw;
+      if (attempt == kMaxDrawsPerSeed) throw;
     }
   }
 }

@@ -184,6 +184,21 @@ TEST(OpenScenario, StictionShowsWhatBacklashCannotDescribe) {
   }
 }
 
+// An effect that the size search shrinks to nothing is no effect: in closed loop, stiction of any size can
+// set off a stick-slip cycle larger than the target, and the search ended at bands of about 1e-12 of the
+// input (retired seed). Such a draw is rejected and the scenario redrawn.
+TEST(OpenScenario, AnEffectSizedToNothingIsRedrawn) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kStiction;
+  so.seed = 1400155;
+  const OpenScenario sc = MakeOpenScenario(so);
+  double mean = 0.0, var = 0.0;
+  for (double v : sc.ident.u) mean += v / sc.ident.u.size();
+  for (double v : sc.ident.u) var += (v - mean) * (v - mean) / sc.ident.u.size();
+  ASSERT_EQ(sc.truth.blocks.size(), 1u);
+  for (double band : sc.truth.blocks[0].params) EXPECT_GT(std::abs(band), 1e-6 * std::sqrt(var));
+}
+
 // Stick-slip (static band above the kinetic band) on a multisine: the stiction fit opens the jump from
 // the backlash fit (equal bands) and ends below it in error; from its own grid, scored with the
 // nominal's poles, it stayed at a small backlash-like band (development seed 3015).
