@@ -87,41 +87,11 @@ bool OutputMapStart(AugmentedModel* m, int degree, const Segment& s) {
 // Input map by an over-parametrised Hammerstein least squares at the linear model's poles:
 // y = offset + sum_j sum_k theta_jk (u^k / A)_{t-d-j}, then theta ~ b c^T (rank one, c_1 = 1).
 bool InputMapStart(AugmentedModel* m, int degree, const Segment& s) {
-  const auto& a = m->nominal.linear.a;
-  const int nb = static_cast<int>(m->nominal.linear.b.size());
-  const long d = m->nominal.linear.delay;
-  const std::size_t n = s.Count();
-  std::vector<Vec> f(degree);
-  for (int k = 1; k <= degree; ++k) {
-    Vec x(s.u->size());
-    for (std::size_t t = 0; t < x.size(); ++t) x[t] = std::pow((*s.u)[t], k);
-    f[k - 1] = LinearBlock{a, {1.0}, 0}.simulate(x);
-  }
-  Eigen::MatrixXd phi(n, nb * degree + 1);
-  Eigen::VectorXd yy(n);
-  for (std::size_t t = s.skip; t < s.End(); ++t) {
-    for (int j = 0; j < nb; ++j)
-      for (int k = 0; k < degree; ++k) {
-        const long i = static_cast<long>(t) - d - j;
-        phi(t - s.skip, j * degree + k) = i >= 0 ? f[k][i] : 0.0;
-      }
-    phi(t - s.skip, nb * degree) = 1.0;
-    yy(t - s.skip) = (*s.y)[t];
-  }
-  const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
-  if (!th.allFinite()) return false;
-  Eigen::MatrixXd T(nb, degree);
-  for (int j = 0; j < nb; ++j)
-    for (int k = 0; k < degree; ++k) T(j, k) = th(j * degree + k);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(T, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const double v1 = svd.matrixV()(0, 0);
-  if (std::abs(v1) < 1e-12) return false;
-  Vec c(degree);
-  for (int k = 0; k < degree; ++k) c[k] = svd.matrixV()(k, 0) / v1;
-  for (int j = 0; j < nb; ++j) m->nominal.linear.b[j] = svd.singularValues()(0) * svd.matrixU()(j, 0) * v1;
-  m->nominal.input = StaticMap::Polynomial(c);
-  m->output_offset = th(nb * degree);
-  return true;
+  m->nominal.input = StaticMap::Polynomial(IdentityCoefficients(degree));
+  RefitOptions o;
+  o.estimate_initial_state = false;
+  o.fit_output_offset = true;
+  return SolveInputMapAndNumerator(m, s, o);
 }
 
 // Random map coefficients around identity, scaled to the signal each map sees.

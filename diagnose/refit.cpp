@@ -238,6 +238,58 @@ bool SolveNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) 
   return true;
 }
 
+bool SolveInputMapAndNumerator(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  const StaticMap& in = m->nominal.input;
+  if (in.kind != StaticMap::Kind::kPolynomial || m->nominal.output.kind != StaticMap::Kind::kIdentity ||
+      HasStateBlock(*m) || HasOutputBlock(*m))
+    return false;
+  const int degree = static_cast<int>(in.coefficients.size());
+  const auto& a = m->nominal.linear.a;
+  const int nb = static_cast<int>(m->nominal.linear.b.size());
+  const long d = m->nominal.linear.delay;
+  const Vec x = m->AfterInputBlocks(*s.u);
+  // Columns j * degree + k: (x^(k+1) / A) delayed by d + j; then the offset; then the initial state's
+  // free responses (the columns NumeratorAndInitialStateRegressors gives beyond the numerator).
+  std::vector<Vec> f(degree);
+  for (int k = 0; k < degree; ++k) {
+    Vec p(x.size());
+    for (std::size_t t = 0; t < x.size(); ++t) p[t] = std::pow(x[t], k + 1);
+    f[k] = LinearBlock{a, {1.0}, 0}.simulate(p);
+  }
+  const Eigen::MatrixXd basis = NumeratorAndInitialStateRegressors(*m, s, o);
+  if (basis.size() == 0) return false;
+  const int ninit = static_cast<int>(basis.cols()) - nb;
+  const int offset_cols = o.fit_output_offset ? 1 : 0;
+  const std::size_t n = s.Count();
+  Eigen::MatrixXd phi(n, nb * degree + offset_cols + ninit);
+  Eigen::VectorXd yy(n);
+  for (std::size_t t = s.skip; t < s.End(); ++t) {
+    for (int j = 0; j < nb; ++j)
+      for (int k = 0; k < degree; ++k) {
+        const long i = static_cast<long>(t) - d - j;
+        phi(t - s.skip, j * degree + k) = i >= 0 ? f[k][i] : 0.0;
+      }
+    if (o.fit_output_offset) phi(t - s.skip, nb * degree) = 1.0;
+    yy(t - s.skip) = (*s.y)[t];
+  }
+  phi.rightCols(ninit) = basis.rightCols(ninit);
+  const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
+  if (!th.allFinite()) return false;
+  Eigen::MatrixXd theta(nb, degree);
+  for (int j = 0; j < nb; ++j)
+    for (int k = 0; k < degree; ++k) theta(j, k) = th(j * degree + k);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(theta, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const double v1 = svd.matrixV()(0, 0);
+  if (std::abs(v1) < 1e-12) return false;
+  Vec c(degree);
+  for (int k = 0; k < degree; ++k) c[k] = svd.matrixV()(k, 0) / v1;
+  for (int j = 0; j < nb; ++j) m->nominal.linear.b[j] = svd.singularValues()(0) * svd.matrixU()(j, 0) * v1;
+  m->nominal.input = StaticMap::Polynomial(c);
+  if (o.fit_output_offset) m->output_offset = th(nb * degree);
+  if (ninit > 0) m->initial_state.assign(th.data() + nb * degree + offset_cols, th.data() + th.size());
+  return true;
+}
+
 namespace {
 
 // Whether every output block is a dead band or a saturation: static blocks with a slope of 0 or 1.
@@ -1003,6 +1055,13 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
     if (!SolveNumerator(&m, s, o) && effect == Effect::kQuantization) {
       AugmentedModel t = m;
       if (SolveNumeratorThroughOutputMap(&t, s, o)) resolved.emplace_back(SumSquaredError(t, s), t);
+    }
+    // Under a polynomial input map the map itself is re-solved with the numerator at an input quantizer's
+    // grid points: held at the baseline's shape, it bends the levels of a step other than the one it was
+    // fitted for, and the true step can rank far down the grid.
+    if (effect == Effect::kQuantization && location == Location::kInput) {
+      AugmentedModel t = m;
+      if (SolveInputMapAndNumerator(&t, s, o) && MapsMonotone(t, u)) resolved.emplace_back(SumSquaredError(t, s), t);
     }
     const double c = SumSquaredError(m, s);
     if (std::isfinite(c)) scored.emplace_back(c, m);

@@ -84,6 +84,12 @@ void EstimateInitialState(AugmentedModel* model, const Segment& data, const Refi
 // an output or a state block.
 bool SolveNumerator(AugmentedModel* model, const Segment& data, const RefitOptions& options);
 
+// For fixed poles under a polynomial input map and an identity output map (no state or output block): the
+// over-parametrised Hammerstein least squares y ~ offset + sum_j sum_k theta_jk (x^k / A)_{t-d-j} (+ the
+// initial state), x the input after the input blocks, split into numerator and map by its rank-one
+// approximation theta ~ b c^T (c_1 = 1). False (model unchanged) for other models.
+bool SolveInputMapAndNumerator(AugmentedModel* model, const Segment& data, const RefitOptions& options);
+
 // For fixed poles under a polynomial output map, output dead bands and saturations, or both: Gauss–Newton
 // on the numerator, the output offset and the initial state (the map and the blocks linearised about the
 // current inner signal, `iterations` least-squares solves); keeps the iterate of lowest cost. Returns

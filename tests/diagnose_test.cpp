@@ -479,6 +479,39 @@ TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap
   EXPECT_FALSE(SolveNumeratorThroughOutputMap(&identity, seg, {}));
 }
 
+// Under a polynomial input map the output is bilinear in the numerator and the map; the over-parametrised
+// least squares (poles held) with its rank-one split recovers both, the offset and the initial state, with
+// the input after an input quantizer, from a start whose map is the identity.
+TEST(Refit, InputMapNumeratorOffsetAndInitialStateAreReSolvedAfterTheInputBlocks) {
+  std::mt19937_64 rng(7);
+  const Vec u = FilteredNoise(rng, 600, 0.8, 0.6);
+  std::normal_distribution<double> g(0.0, 1.0);
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 1};
+  truth.nominal.input = StaticMap::Polynomial({1.0, 0.2, 0.3});
+  truth.blocks = {{Effect::kQuantization, Location::kInput, {0.15, 0.05}}};
+  truth.output_offset = 0.3;
+  truth.initial_state = {1.5};
+  Vec y = truth.simulate(u);
+  for (auto& v : y) v += 0.01 * g(rng);
+  const Segment seg{&u, &y, 0, 0};
+  AugmentedModel start = truth;
+  start.nominal.input = StaticMap::Polynomial({1.0, 0.0, 0.0});
+  start.nominal.linear.b = {0.25, 0.05};
+  start.output_offset = 0.0;
+  start.initial_state = {0.0};
+  ASSERT_TRUE(SolveInputMapAndNumerator(&start, seg, {}));
+  EXPECT_NEAR(start.nominal.input.coefficients[1], 0.2, 0.02);
+  EXPECT_NEAR(start.nominal.input.coefficients[2], 0.3, 0.02);
+  EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.01);
+  EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.01);
+  EXPECT_NEAR(start.output_offset, 0.3, 0.01);
+  EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
+  AugmentedModel identity = truth;  // no polynomial input map: not this re-solve's case
+  identity.nominal.input = StaticMap{};
+  EXPECT_FALSE(SolveInputMapAndNumerator(&identity, seg, {}));
+}
+
 // An output dead band is not linear in the numerator, offset and initial state either: the re-solve
 // linearises through the band (slope 0 inside, 1 outside) and recovers them; an output quantizer is not
 // this re-solve's case.
