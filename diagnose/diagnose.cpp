@@ -237,23 +237,11 @@ double PenalisedCost(const AugmentedModel& m, const Segment& s, int k) {
   return SumSquaredError(m, s) * (n + k) / std::max(n - k, 1.0);
 }
 
-// When only one of the two tests confirms a candidate, its two fits may sit in different optima: the
-// fit on the fitting part (judged on the held-out tail) and its refit on the whole recording (judged on
-// validation) started from it. The part that did not confirm is refitted from the other fit's numbers
-// and, for the whole recording, from the block's own grid as well; a new fit is kept only when it lowers
-// the cost on its own training data (never chosen by the part it is judged on), penalised for the effect
-// parameters where the limit sides differ (WholeRecordingSides).
-void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Location location, LimitSides sides,
-                   Finding* f) {
-  if (!f->holdout.significant) {
-    const AugmentedModel alt = RefitModel(f->model, c.fit, c.o.refit).model;
-    if (SumSquaredError(alt, c.fit) < SumSquaredError(f->fitted, c.fit)) {
-      f->fitted = alt;
-      f->blocks = alt.blocks;
-      f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(alt), c.nfit, c.n, f->extra_parameters, c.o.significance_z);
-    }
-    return;
-  }
+// The refit on the whole recording restarted from the block's own grid (for saturation-type blocks with
+// every side of limits, WholeRecordingSides), kept when it lowers the cost on the whole recording,
+// penalised for the effect parameters where the limit sides differ; validation is then re-scored.
+void RestartOnWholeRecording(const Context& c, const Reference& ref, Effect effect, Location location, LimitSides sides,
+                             Finding* f) {
   const int base_parameters = EffectParameterCount(ref.full);
   const int current = EffectParameterCount(f->model) - base_parameters;
   double best = PenalisedCost(f->model, c.full, current);
@@ -272,6 +260,39 @@ void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Locati
   if (changed)
     f->validation = c.Compare(ref.valid_residual, c.ValidationResidual(f->model), c.skip, c.nv, f->extra_parameters,
                               c.o.validation_z);
+}
+
+// When only one of the two tests confirms a candidate, its two fits may sit in different optima: the
+// fit on the fitting part (judged on the held-out tail) and its refit on the whole recording (judged on
+// validation) started from it. The part that did not confirm is refitted from the other fit's numbers
+// and, for the whole recording, from the block's own grid as well; a new fit is kept only when it lowers
+// the cost on its own training data (never chosen by the part it is judged on), penalised for the effect
+// parameters where the limit sides differ (WholeRecordingSides).
+void ReconcileFits(const Context& c, const Reference& ref, Effect effect, Location location, LimitSides sides,
+                   Finding* f) {
+  if (!f->holdout.significant) {
+    const AugmentedModel alt = RefitModel(f->model, c.fit, c.o.refit).model;
+    if (SumSquaredError(alt, c.fit) < SumSquaredError(f->fitted, c.fit)) {
+      f->fitted = alt;
+      f->blocks = alt.blocks;
+      f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(alt), c.nfit, c.n, f->extra_parameters, c.o.significance_z);
+    }
+    return;
+  }
+  RestartOnWholeRecording(c, ref, effect, location, sides, f);
+}
+
+// A limit that the fitting part never reaches (its prediction stays inside it) cannot be placed there:
+// every limit beyond the fitted signal costs the same, the grid offers none, and neither test confirms
+// the fit although the held-out tail and validation reach the limit (development seed 1 500 409, PRBS: the
+// output's lower limit lies 0.0004 below the fitting part's lowest prediction and 0.07 above the tail's).
+// Its refit on the whole recording, which reaches it, is then restarted from the grid as well; validation
+// judges it, and the roles-swapped test stands in for the held-out tail.
+void PlaceLimitsOnWholeRecording(const Context& c, const Reference& ref, Effect effect, Location location,
+                                 LimitSides sides, Finding* f) {
+  if (effect != Effect::kSaturation && effect != Effect::kStateSaturation) return;
+  if (f->holdout.significant || f->validation.significant) return;
+  RestartOnWholeRecording(c, ref, effect, location, sides, f);
 }
 
 // Whether predictions a and b agree on `agree` to rounding (`scale`: the size of the residuals there).
@@ -807,6 +828,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
   f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
                            c.o.validation_z);
+  PlaceLimitsOnWholeRecording(c, ref, effect, location, chosen, &f);
   if (f.holdout.significant != f.validation.significant) ReconcileFits(c, ref, effect, location, chosen, &f);
   if (!f.holdout.significant) ChooseTiedValueAmongFittingTies(c, ref, &f);
   if (f.holdout.significant && !f.validation.significant) ChooseTiedValueAmongIdentificationTies(c, ref, &f);
@@ -1100,7 +1122,11 @@ double StickSlipZ(const Context& c, const Finding& backlash, const Finding& stic
     }
   };
   add(c.ValidationResidual(backlash.model), c.ValidationResidual(stiction.model), c.skip, c.nv);
-  add(c.IdentResidual(backlash.fitted), c.IdentResidual(stiction.fitted), c.nfit, c.n);
+  // The fits on the fitting part count only where the held-out tail judged them: a finding that passed by
+  // the roles-swapped test may have a fit there that never placed its block (a limit the fitting part does
+  // not reach), and its residual on the tail is then the baseline's.
+  if (!backlash.swapped_stands_in && !stiction.swapped_stands_in)
+    add(c.IdentResidual(backlash.fitted), c.IdentResidual(stiction.fitted), c.nfit, c.n);
   *share = 0.0;
   if (!(dd > 0) || count == 0) return 0.0;
   *share = de / dd;

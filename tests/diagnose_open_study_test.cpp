@@ -618,5 +618,20 @@ TEST(OpenStudy, TheFitOnTheWholeRecordingMustBePhysicallyMeaningfulToo) {
   EXPECT_EQ(r.verdict, Effect::kNone) << r.message;
 }
 
+// A lower output limit the fitting part never reaches (development seed 1 500 409, PRBS, hw:2,3,1,3,2,
+// nominal given): the fitting part's lowest prediction lies 0.0004 above it, the held-out tail and
+// validation reach 0.07 below it. Fitted there, the output saturation placed nothing (1x the baseline's
+// error on both tests) and the state saturation, clipping the fitting part by a hair, was named. Its
+// whole-recording refit restarted from the grid places the limit (-0.477 against the true -0.4777),
+// validation confirms it (0.031x) and the roles-swapped test stands in for the tail; ranked against the
+// state saturation by their prediction difference on validation only (the output saturation's fit on
+// the fitting part, which never placed its limit, has the baseline's residual on the tail).
+TEST(OpenStudy, ALimitTheFittingPartNeverReachesIsPlacedOnTheWholeRecording) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1500409);
+  ASSERT_TRUE(Names(r, Effect::kSaturation, Location::kOutput)) << r.message;
+  EXPECT_NEAR(r.verdict_blocks.front().params[0], -0.4777, 0.01);
+  EXPECT_TRUE(r.findings.front().swapped_stands_in);
+}
+
 }  // namespace
 }  // namespace hw::diagnose
