@@ -86,12 +86,17 @@ bool OutputMapStart(AugmentedModel* m, int degree, const Segment& s) {
 
 // Input map by an over-parametrised Hammerstein least squares at the linear model's poles:
 // y = offset + sum_j sum_k theta_jk (u^k / A)_{t-d-j}, then theta ~ b c^T (rank one, c_1 = 1).
+// The output map, when the structure has one, starts at identity: the least squares sees the model without it.
 bool InputMapStart(AugmentedModel* m, int degree, const Segment& s) {
+  const StaticMap output = m->nominal.output;
+  m->nominal.output = StaticMap{};
   m->nominal.input = StaticMap::Polynomial(IdentityCoefficients(degree));
   RefitOptions o;
   o.estimate_initial_state = false;
   o.fit_output_offset = true;
-  return SolveInputMapAndNumerator(m, s, o);
+  const bool solved = SolveInputMapAndNumerator(m, s, o);
+  m->nominal.output = output;
+  return solved;
 }
 
 // Random map coefficients around identity, scaled to the signal each map sees.

@@ -49,6 +49,20 @@ TEST(Study, FittedHwNominalOnNullCasesGivesNone) {
   }
 }
 
+// With both maps in the structure, the input map's Hammerstein least-squares start is tried too (the output
+// map starting at identity), beside the output map's own least-squares start.
+TEST(Study, BothMapsGetTheirLeastSquaresStarts) {
+  ScenarioOptions so;
+  so.seed = 3;
+  so.samples = 1200;
+  const Scenario sc = MakeScenario(so);
+  const NominalFit fit = FitNominal(NominalSpec::Parse("hw:2,2,3,3"), {&sc.ident.u, &sc.ident.y, 0, 0});
+  std::vector<std::string> names;
+  for (const auto& start : fit.starts) names.push_back(start.name);
+  EXPECT_NE(std::find(names.begin(), names.end(), "input map by Hammerstein least squares"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "output map by least squares"), names.end());
+}
+
 // The recordings start in the middle of a run (not from rest): the initial state is estimated, so the
 // transient neither inflates the error nor produces a verdict; simulating from rest does inflate it.
 TEST(Diagnose, RecordingsThatDoNotStartFromRest) {
