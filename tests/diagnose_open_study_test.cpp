@@ -480,12 +480,9 @@ TEST(OpenStudy, InputMapShapeUnderAStateSaturationIsJudgedOnValidation) {
 // recording alike; the search among ties reached only the steps within 3 % with the offset scaled along,
 // and validation rejected the fit (1.95x the baseline's error). Both nominals.
 TEST(OpenStudy, InputQuantizerGridsThatIndexTheSamplesAlikeAreJudgedOnValidation) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kQuantization;
-  so.location = Location::kInput;
-  so.seed = 1300078;
   for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseOpenScenario(so, fitted).report, Effect::kQuantization, Location::kInput))
+    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1300078, fitted), Effect::kQuantization,
+                      Location::kInput))
         << (fitted ? "fitted" : "given");
 }
 
@@ -544,12 +541,9 @@ TEST(OpenStudy, OutputAndStateSaturationAreSettledByTheirPredictionDifference) {
 // scored after the Gauss-Newton re-solve through the map, the true step's points rank first, and the
 // best 3 so scored are refined besides the 12 (identification fit 0.454 against 0.977 on the fitting part).
 TEST(OpenStudy, InputQuantizerGridUnderAPolynomialOutputMapIsScoredAfterAReSolveThroughTheMap) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kQuantization;
-  so.location = Location::kInput;
-  so.seed = 1300168;
   for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseOpenScenario(so, fitted).report, Effect::kQuantization, Location::kInput))
+    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1300168, fitted), Effect::kQuantization,
+                      Location::kInput))
         << (fitted ? "fitted" : "given");
 }
 
@@ -560,12 +554,9 @@ TEST(OpenStudy, InputQuantizerGridUnderAPolynomialOutputMapIsScoredAfterAReSolve
 // nominal fit was reported failed. Scored after re-solving the map with the numerator, the grid points of
 // the true grid (up to a scaling the map absorbs) rank among the best and the quantizer is named.
 TEST(OpenStudy, InputQuantizerGridUnderAPolynomialInputMapIsScoredWithTheMapReSolved) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kQuantization;
-  so.location = Location::kInput;
-  so.seed = 1500114;
   for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseOpenScenario(so, fitted).report, Effect::kQuantization, Location::kInput))
+    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1500114, fitted), Effect::kQuantization,
+                      Location::kInput))
         << (fitted ? "fitted" : "given");
 }
 

@@ -439,19 +439,25 @@ TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt
 
 // Under a polynomial output map the output is not linear in the numerator, offset and initial state; the
 // Gauss-Newton re-solve through the map (poles held) recovers them from a start far off.
-// The set-up the re-solves through an output map share: a first-order system (b = 0.4, 0.2) driven by filtered
-// noise with noise 0.01, and a start whose numerator, offset and initial state are far off.
+// The set-up the re-solves of the numerator (with a map or a block around it) share: a first-order system
+// (b = 0.4, 0.2) driven by filtered noise with noise 0.01, and a start whose numerator, offset and initial
+// state are far off.
+AugmentedModel FirstOrderTruth(long delay = 0) {
+  AugmentedModel truth;
+  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, delay};
+  return truth;
+}
+
 struct ReSolveCase {
   Vec u, y;
   AugmentedModel start;
 };
 
-ReSolveCase ReSolveCaseFor(AugmentedModel truth, unsigned seed) {
+ReSolveCase ReSolveCaseFor(const AugmentedModel& truth, unsigned seed, double input_gain = 0.4) {
   std::mt19937_64 rng(seed);
   ReSolveCase c;
-  c.u = FilteredNoise(rng, 600, 0.8, 0.4);
+  c.u = FilteredNoise(rng, 600, 0.8, input_gain);
   std::normal_distribution<double> g(0.0, 1.0);
-  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 0};
   c.y = truth.simulate(c.u);
   for (auto& v : c.y) v += 0.01 * g(rng);
   c.start = truth;
@@ -461,8 +467,18 @@ ReSolveCase ReSolveCaseFor(AugmentedModel truth, unsigned seed) {
   return c;
 }
 
+// The re-solved start has the truth's numerator (0.4, 0.2) and output offset within `tolerance` and fits
+// the recording to its noise.
+void ExpectNumeratorAndOffsetRecovered(const ReSolveCase& c, double offset, double tolerance) {
+  const Segment seg{&c.u, &c.y, 0, 0};
+  EXPECT_NEAR(c.start.nominal.linear.b[0], 0.4, tolerance);
+  EXPECT_NEAR(c.start.nominal.linear.b[1], 0.2, tolerance);
+  EXPECT_NEAR(c.start.output_offset, offset, tolerance);
+  EXPECT_LT(SumSquaredError(c.start, seg), 1.5 * 600 * 0.01 * 0.01);
+}
+
 TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap) {
-  AugmentedModel truth;
+  AugmentedModel truth = FirstOrderTruth();
   truth.nominal.output = StaticMap::Polynomial({1.0, 0.0, 0.3});
   truth.output_offset = 0.3;
   truth.initial_state = {1.5};
@@ -470,10 +486,7 @@ TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap
   const Segment seg{&c.u, &c.y, 0, 0};
   AugmentedModel& start = c.start;
   EXPECT_TRUE(SolveNumeratorThroughOutputMap(&start, seg, {}));
-  EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.01);
-  EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.01);
-  EXPECT_NEAR(start.output_offset, 0.3, 0.01);
-  EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
+  ExpectNumeratorAndOffsetRecovered(c, 0.3, 0.01);
   AugmentedModel identity = start;  // no polynomial output map: not this re-solve's case
   identity.nominal.output = StaticMap{};
   EXPECT_FALSE(SolveNumeratorThroughOutputMap(&identity, seg, {}));
@@ -483,30 +496,19 @@ TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap
 // least squares (poles held) with its rank-one split recovers both, the offset and the initial state, with
 // the input after an input quantizer, from a start whose map is the identity.
 TEST(Refit, InputMapNumeratorOffsetAndInitialStateAreReSolvedAfterTheInputBlocks) {
-  std::mt19937_64 rng(7);
-  const Vec u = FilteredNoise(rng, 600, 0.8, 0.6);
-  std::normal_distribution<double> g(0.0, 1.0);
-  AugmentedModel truth;
-  truth.nominal.linear = {{-0.6}, {0.4, 0.2}, 1};
+  AugmentedModel truth = FirstOrderTruth(1);
   truth.nominal.input = StaticMap::Polynomial({1.0, 0.2, 0.3});
   truth.blocks = {{Effect::kQuantization, Location::kInput, {0.15, 0.05}}};
   truth.output_offset = 0.3;
   truth.initial_state = {1.5};
-  Vec y = truth.simulate(u);
-  for (auto& v : y) v += 0.01 * g(rng);
-  const Segment seg{&u, &y, 0, 0};
-  AugmentedModel start = truth;
+  ReSolveCase c = ReSolveCaseFor(truth, 7, 0.6);
+  const Segment seg{&c.u, &c.y, 0, 0};
+  AugmentedModel& start = c.start;
   start.nominal.input = StaticMap::Polynomial({1.0, 0.0, 0.0});
-  start.nominal.linear.b = {0.25, 0.05};
-  start.output_offset = 0.0;
-  start.initial_state = {0.0};
   ASSERT_TRUE(SolveInputMapAndNumerator(&start, seg, {}));
   EXPECT_NEAR(start.nominal.input.coefficients[1], 0.2, 0.02);
   EXPECT_NEAR(start.nominal.input.coefficients[2], 0.3, 0.02);
-  EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.01);
-  EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.01);
-  EXPECT_NEAR(start.output_offset, 0.3, 0.01);
-  EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
+  ExpectNumeratorAndOffsetRecovered(c, 0.3, 0.01);
   AugmentedModel identity = truth;  // no polynomial input map: not this re-solve's case
   identity.nominal.input = StaticMap{};
   EXPECT_FALSE(SolveInputMapAndNumerator(&identity, seg, {}));
@@ -516,7 +518,7 @@ TEST(Refit, InputMapNumeratorOffsetAndInitialStateAreReSolvedAfterTheInputBlocks
 // linearises through the band (slope 0 inside, 1 outside) and recovers them; an output quantizer is not
 // this re-solve's case.
 TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAnOutputDeadBand) {
-  AugmentedModel truth;
+  AugmentedModel truth = FirstOrderTruth();
   truth.blocks = {{Effect::kDeadzone, Location::kOutput, {0.3, 0.1}}};
   truth.output_offset = 0.2;
   truth.initial_state = {1.0};
@@ -524,10 +526,7 @@ TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAnOutputDeadBand) {
   const Segment seg{&c.u, &c.y, 0, 0};
   AugmentedModel& start = c.start;
   EXPECT_TRUE(SolveNumeratorThroughOutputMap(&start, seg, {}, 6));
-  EXPECT_NEAR(start.nominal.linear.b[0], 0.4, 0.02);
-  EXPECT_NEAR(start.nominal.linear.b[1], 0.2, 0.02);
-  EXPECT_NEAR(start.output_offset, 0.2, 0.02);
-  EXPECT_LT(SumSquaredError(start, seg), 1.5 * 600 * 0.01 * 0.01);
+  ExpectNumeratorAndOffsetRecovered(c, 0.2, 0.02);
   AugmentedModel quantized = start;
   quantized.blocks = {{Effect::kQuantization, Location::kOutput, {0.1, 0.0}}};
   EXPECT_FALSE(SolveNumeratorThroughOutputMap(&quantized, seg, {}));
