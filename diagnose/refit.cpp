@@ -175,33 +175,47 @@ namespace {
 // samples: column j is f_{t-d-j} with f = x / A(q) (x the input map's output after the input blocks),
 // column nb + i the free response h_i of 1/A(q) to z_{-i} = 1 (when the initial state is estimated).
 // Empty when the segment is too short for them.
+// How many initial-state values the least squares estimates: one per pole when asked for.
+int InitialStateCount(const AugmentedModel& m, const RefitOptions& o) {
+  return o.estimate_initial_state ? static_cast<int>(m.nominal.linear.a.size()) : 0;
+}
+
+// Whether the rows of s leave the least squares over-determined for nb numerator and ninit state columns.
+bool EnoughRows(const Segment& s, int nb, int ninit) { return s.Count() > static_cast<std::size_t>(nb + ninit + 1); }
+
+// Columns first + j * stride (j < nb) over the rows of s: f delayed by d + j, 0 before the recording starts.
+void PutDelayedColumns(const Vec& f, int nb, long d, const Segment& s, int first, int stride, Eigen::MatrixXd* phi) {
+  for (std::size_t t = s.skip; t < s.End(); ++t)
+    for (int j = 0; j < nb; ++j) {
+      const long k = static_cast<long>(t) - d - j;
+      (*phi)(t - s.skip, first + j * stride) = k >= 0 ? f[k] : 0.0;
+    }
+}
+
+// Columns first.. over the rows of s: the free responses of 1/A(q) to each initial state z_{-i} = 1.
+void PutFreeResponseColumns(const std::vector<double>& a, int ninit, const Segment& s, int first, Eigen::MatrixXd* phi) {
+  for (int i = 0; i < ninit; ++i) {
+    AugmentedModel free;
+    free.nominal.linear = {a, {0.0}, 0};
+    free.initial_state.assign(ninit, 0.0);
+    free.initial_state[i] = 1.0;
+    Vec h;
+    free.simulate(Vec(s.End(), 0.0), &h);
+    for (std::size_t t = s.skip; t < s.End(); ++t) (*phi)(t - s.skip, first + i) = h[t];
+  }
+}
+
 Eigen::MatrixXd NumeratorAndInitialStateRegressors(const AugmentedModel& m, const Segment& s, const RefitOptions& o) {
   Vec x = m.AfterInputBlocks(*s.u);
   for (auto& v : x) v = m.nominal.input(v);
   const auto& a = m.nominal.linear.a;
   const Vec f = LinearBlock{a, {1.0}, 0}.simulate(x);
   const int nb = static_cast<int>(m.nominal.linear.b.size());
-  const int ninit = o.estimate_initial_state ? static_cast<int>(a.size()) : 0;
-  const long d = m.nominal.linear.delay;
-  const std::size_t n = s.End();
-  if (s.Count() <= static_cast<std::size_t>(nb + ninit + 1)) return {};
-  std::vector<Vec> h(ninit);
-  for (int i = 0; i < ninit; ++i) {
-    AugmentedModel free;
-    free.nominal.linear = {a, {0.0}, 0};
-    free.initial_state.assign(ninit, 0.0);
-    free.initial_state[i] = 1.0;
-    free.simulate(Vec(n, 0.0), &h[i]);
-  }
+  const int ninit = InitialStateCount(m, o);
+  if (!EnoughRows(s, nb, ninit)) return {};
   Eigen::MatrixXd phi(s.Count(), nb + ninit);
-  for (std::size_t t = s.skip; t < n; ++t) {
-    const std::size_t r = t - s.skip;
-    for (int j = 0; j < nb; ++j) {
-      const long k = static_cast<long>(t) - d - j;
-      phi(r, j) = k >= 0 ? f[k] : 0.0;
-    }
-    for (int i = 0; i < ninit; ++i) phi(r, nb + i) = h[i][t];
-  }
+  PutDelayedColumns(f, nb, m.nominal.linear.delay, s, 0, 1, &phi);
+  PutFreeResponseColumns(a, ninit, s, nb, &phi);
   return phi;
 }
 
@@ -247,32 +261,22 @@ bool SolveInputMapAndNumerator(AugmentedModel* m, const Segment& s, const RefitO
   const auto& a = m->nominal.linear.a;
   const int nb = static_cast<int>(m->nominal.linear.b.size());
   const long d = m->nominal.linear.delay;
+  const int ninit = InitialStateCount(*m, o);
+  if (!EnoughRows(s, nb, ninit)) return false;
   const Vec x = m->AfterInputBlocks(*s.u);
   // Columns j * degree + k: (x^(k+1) / A) delayed by d + j; then the offset; then the initial state's
-  // free responses (the columns NumeratorAndInitialStateRegressors gives beyond the numerator).
-  std::vector<Vec> f(degree);
+  // free responses.
+  const int offset_cols = o.fit_output_offset ? 1 : 0;
+  Eigen::MatrixXd phi(s.Count(), nb * degree + offset_cols + ninit);
   for (int k = 0; k < degree; ++k) {
     Vec p(x.size());
     for (std::size_t t = 0; t < x.size(); ++t) p[t] = std::pow(x[t], k + 1);
-    f[k] = LinearBlock{a, {1.0}, 0}.simulate(p);
+    PutDelayedColumns(LinearBlock{a, {1.0}, 0}.simulate(p), nb, d, s, k, degree, &phi);
   }
-  const Eigen::MatrixXd basis = NumeratorAndInitialStateRegressors(*m, s, o);
-  if (basis.size() == 0) return false;
-  const int ninit = static_cast<int>(basis.cols()) - nb;
-  const int offset_cols = o.fit_output_offset ? 1 : 0;
-  const std::size_t n = s.Count();
-  Eigen::MatrixXd phi(n, nb * degree + offset_cols + ninit);
-  Eigen::VectorXd yy(n);
-  for (std::size_t t = s.skip; t < s.End(); ++t) {
-    for (int j = 0; j < nb; ++j)
-      for (int k = 0; k < degree; ++k) {
-        const long i = static_cast<long>(t) - d - j;
-        phi(t - s.skip, j * degree + k) = i >= 0 ? f[k][i] : 0.0;
-      }
-    if (o.fit_output_offset) phi(t - s.skip, nb * degree) = 1.0;
-    yy(t - s.skip) = (*s.y)[t];
-  }
-  phi.rightCols(ninit) = basis.rightCols(ninit);
+  if (o.fit_output_offset) phi.col(nb * degree).setOnes();
+  PutFreeResponseColumns(a, ninit, s, nb * degree + offset_cols, &phi);
+  Eigen::VectorXd yy(s.Count());
+  for (std::size_t t = s.skip; t < s.End(); ++t) yy(t - s.skip) = (*s.y)[t];
   const Eigen::VectorXd th = phi.colPivHouseholderQr().solve(yy);
   if (!th.allFinite()) return false;
   Eigen::MatrixXd theta(nb, degree);
