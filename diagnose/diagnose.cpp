@@ -1104,6 +1104,36 @@ void PreferBacklashToJumplessStiction(std::vector<Finding>* fs) {
   }
 }
 
+// The first residual regressed on the difference of two residuals, summed over sample ranges: the
+// coefficient (`Share`) and its distance from 0.5 in standard errors (`Z`, the second residual's RMS over |d|).
+struct DifferenceRegression {
+  double dd = 0.0, de = 0.0, ss = 0.0;
+  std::size_t count = 0;
+  void Add(const Vec& ea, const Vec& eb, std::size_t from, std::size_t to) {
+    for (std::size_t t = from; t < to && t < ea.size() && t < eb.size(); ++t) {
+      const double d = ea[t] - eb[t];
+      dd += d * d, de += d * ea[t], ss += eb[t] * eb[t];
+      ++count;
+    }
+  }
+  double Share() const { return dd > 0 && count > 0 ? de / dd : 0.0; }
+  double Z() const {
+    if (!(dd > 0) || count == 0) return 0.0;
+    const double se = std::sqrt(ss / count / dd);
+    return se > 0 ? (Share() - 0.5) / se : 0.0;
+  }
+};
+
+// Whether a fit's blocks change its prediction anywhere on the fitting part. A limit the optimiser left
+// beyond every value the fitting part reaches (where the cost is flat) clips nothing, and on the held-out
+// tail that fit is the baseline, not the block at its place.
+bool BlocksActOnFittingPart(const Context& c, const AugmentedModel& fitted) {
+  const Vec with = fitted.simulate(c.ident.u), without = WithoutBlocks(fitted).simulate(c.ident.u);
+  for (std::size_t t = c.skip; t < c.nfit && t < with.size(); ++t)
+    if (with[t] != without[t]) return true;
+  return false;
+}
+
 // Stiction and backlash differ only where the stem sticks and then slips (the jump); elsewhere their
 // predictions agree, and the whole-recording scores of two eligible fits are often tied within the
 // extra parameter's penalty. On the data neither fit was fitted on (validation, and the held-out tail for
@@ -1112,26 +1142,27 @@ void PreferBacklashToJumplessStiction(std::vector<Finding>* fs) {
 // two fit equally. Returns (coefficient - 0.5) / its standard error (the stiction residual's RMS over
 // |d|); 0 when the predictions do not differ. `share` gets the coefficient.
 double StickSlipZ(const Context& c, const Finding& backlash, const Finding& stiction, double* share) {
-  double dd = 0.0, de = 0.0, ss = 0.0;
-  std::size_t count = 0;
-  auto add = [&](const Vec& eb, const Vec& es, std::size_t from, std::size_t to) {
-    for (std::size_t t = from; t < to; ++t) {
-      const double d = eb[t] - es[t];
-      dd += d * d, de += d * eb[t], ss += es[t] * es[t];
-      ++count;
-    }
-  };
-  add(c.ValidationResidual(backlash.model), c.ValidationResidual(stiction.model), c.skip, c.nv);
-  // The fits on the fitting part count only where the held-out tail judged them: a finding that passed by
-  // the roles-swapped test may have a fit there that never placed its block (a limit the fitting part does
-  // not reach), and its residual on the tail is then the baseline's.
-  if (!backlash.swapped_stands_in && !stiction.swapped_stands_in)
-    add(c.IdentResidual(backlash.fitted), c.IdentResidual(stiction.fitted), c.nfit, c.n);
-  *share = 0.0;
-  if (!(dd > 0) || count == 0) return 0.0;
-  *share = de / dd;
-  const double se = std::sqrt(ss / count / dd);
-  return se > 0 ? (*share - 0.5) / se : 0.0;
+  DifferenceRegression r;
+  r.Add(c.ValidationResidual(backlash.model), c.ValidationResidual(stiction.model), c.skip, c.nv);
+  // The fits on the fitting part count only where the held-out tail judged them and where both placed their
+  // blocks: a finding that passed by the roles-swapped test, or whose limit the fitting part does not
+  // reach, may have a fit there that clips nothing, and its residual on the tail is then the baseline's.
+  if (!backlash.swapped_stands_in && !stiction.swapped_stands_in && BlocksActOnFittingPart(c, backlash.fitted) &&
+      BlocksActOnFittingPart(c, stiction.fitted))
+    r.Add(c.IdentResidual(backlash.fitted), c.IdentResidual(stiction.fitted), c.nfit, c.n);
+  *share = r.Share();
+  return r.Z();
+}
+
+// The same regression on the whole identification recording, of the two fits made on it. For two
+// candidates with the same number of parameters the in-sample comparison is fair, and it sees every
+// episode the recording holds, where the unseen data may hold none (a limit the validation recording
+// never reaches, an episode inside the fitting part).
+double WholeRecordingDifferenceZ(const Context& c, const Finding& a, const Finding& b, double* share) {
+  DifferenceRegression r;
+  r.Add(c.IdentResidual(a.model), c.IdentResidual(b.model), c.skip, c.n);
+  *share = r.Share();
+  return r.Z();
 }
 
 // The eligible finding with the one block `effect` (at `location`, when given); null when there is none.
@@ -1148,17 +1179,22 @@ Finding* EligibleSingle(std::vector<Finding>* fs, Effect effect, std::optional<L
 // `a`'s residual regressed on it): the one favoured significantly (|z| >= 2) is ranked first, otherwise the
 // ranking by penalised score stands.
 enum class PairVerdict { kFirst, kSecond, kTie };
-PairVerdict RankByPredictionDifference(const Context& c, Finding* a, Finding* b, double* z, double* share) {
-  *z = StickSlipZ(c, *a, *b, share);
-  if (*z >= 2.0) {
+// `a` first when z <= -2, `b` first when z >= 2 (its score raised just above the other's), a tie otherwise.
+PairVerdict RankByZ(double z, Finding* a, Finding* b) {
+  if (z >= 2.0) {
     b->score = std::max(b->score, a->score + 1e-9);
     return PairVerdict::kSecond;
   }
-  if (*z <= -2.0) {
+  if (z <= -2.0) {
     a->score = std::max(a->score, b->score + 1e-9);
     return PairVerdict::kFirst;
   }
   return PairVerdict::kTie;
+}
+
+PairVerdict RankByPredictionDifference(const Context& c, Finding* a, Finding* b, double* z, double* share) {
+  *z = StickSlipZ(c, *a, *b, share);
+  return RankByZ(*z, a, b);
 }
 
 // Both eligible: ranked by RankByPredictionDifference, and the evidence says which way or that they tie.
@@ -1186,17 +1222,31 @@ void SettleStictionBacklash(const Context& c, std::vector<Finding>* fs) {
 // state saturation's block recovers at once, the output's follows the unclipped state). As for stiction
 // and backlash, the first one's residual on unseen data is
 // regressed on the difference of the two predictions (StickSlipZ): when the coefficient differs from 0.5
-// by at least 2 standard errors, the one it favours is ranked first; otherwise the evidence of both says
-// they tie, and the ranking by penalised score stands.
+// by at least 2 standard errors, the one it favours is ranked first. Unseen data may show no episode
+// after which the two differ (a limit validation never reaches, episodes only in the fitting part); on a
+// tie there the same regression over the whole identification recording (WholeRecordingDifferenceZ)
+// decides when the two fits there have as many limits. Otherwise the evidence of both says they tie, and
+// the ranking by penalised score stands.
 void SettleLimitLocations(const Context& c, std::vector<Finding>* fs, Effect ea, Location la, Effect eb, Location lb) {
   Finding* a = EligibleSingle(fs, ea, la);
   Finding* b = EligibleSingle(fs, eb, lb);
   if (!a || !b) return;
   double z = 0.0, share = 0.0;
-  const PairVerdict verdict = RankByPredictionDifference(c, a, b, &z, &share);
-  const std::string where = fmt::format("in the difference of the two predictions on unseen data (the {} residual's "
+  PairVerdict verdict = RankByPredictionDifference(c, a, b, &z, &share);
+  std::string data = "unseen data";
+  // A tie: the fits on the whole identification recording decide, if they can and have as many limits.
+  if (verdict == PairVerdict::kTie && EffectParameterCount(a->model) == EffectParameterCount(b->model)) {
+    double whole_share = 0.0;
+    const double whole_z = WholeRecordingDifferenceZ(c, *a, *b, &whole_share);
+    verdict = RankByZ(whole_z, a, b);
+    if (verdict != PairVerdict::kTie) {
+      z = whole_z, share = whole_share;
+      data = "the identification recording (a tie on unseen data)";
+    }
+  }
+  const std::string where = fmt::format("in the difference of the two predictions on {} (the {} residual's "
                                         "coefficient on it {:.2f}: 0 favours {}, 1 {})",
-                                        a->Label(), share, a->Label(), b->Label());
+                                        data, a->Label(), share, a->Label(), b->Label());
   if (verdict == PairVerdict::kSecond) {
     b->evidence += fmt::format("; ranked above {} {} (z = {:.1f})", a->Label(), where, z);
   } else if (verdict == PairVerdict::kFirst) {

@@ -647,5 +647,28 @@ TEST(OpenStudy, APairBetterThanItsSecondBlockAloneOnValidationStays) {
   EXPECT_TRUE(Names(r, Effect::kStateSaturation, Location::kState));
 }
 
+// An output and a state saturation that tie on unseen data: development seed 1 500 976 (multisine,
+// hw:2,2,3,1,2, state saturation) never reaches the limit on validation, and the clipping episode after
+// which the two differ most lies in the fitting part: on unseen data they differ mostly by their nominal
+// parts' estimation errors (coefficient 0.23, z = -1.1), and the penalised scores (0.8762 against 0.8754)
+// named the output saturation. On the identification recording the output leaving the limit follows the
+// clipped state (whole-recording error 0.051 against 0.066), and that fit now decides the tie.
+TEST(OpenStudy, OutputAndStateSaturationTiedOnUnseenDataAreSettledOnTheIdentificationRecording) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kStateSaturation, Location::kState, 1500976);
+  ASSERT_TRUE(Names(r, Effect::kStateSaturation, Location::kState));
+  EXPECT_NE(r.findings.front().evidence.find("on the identification recording"), std::string::npos)
+      << r.findings.front().evidence;
+}
+
+// The held-out tail compares the two saturations only where both fits on the fitting part placed their
+// limit: in development seed 1 500 657 (filtered noise, hw:1,2,3,1,0, output saturation) the fitting part
+// reaches the limit by a hair; the output saturation's fit there left its limit at -7.83, below every value
+// (the baseline on the tail), the state saturation's at -6.53, and the tail's clipping episode favoured the
+// state saturation by 8.6 standard errors. Validation alone favours the output saturation (z = 2.7).
+TEST(OpenStudy, ALimitTheFittingPartFitNeverPlacedDoesNotJudgeTheTail) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1500657), Effect::kSaturation,
+                    Location::kOutput));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
