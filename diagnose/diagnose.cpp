@@ -218,6 +218,23 @@ bool PhysicallyMeaningful(const EffectBlock& b, const Vec& signal, std::size_t s
   return b.params[0] < Median(mag) && central;
 }
 
+// An output dead band whose input never passes beyond one of its edges is a clamp too, whatever the
+// median test above says: with the output offset moved by the half-width it predicts exactly what a
+// saturation at its centre predicts, with one parameter more. Its input is the model's output before the
+// output blocks (the measured output is the band's output, shifted by the half-width beyond the band).
+// A few samples beyond an edge (under 1 % of them) are the edge of an optimum that cost is flat in.
+constexpr double kMinShareBeyondEachEdgeOfOutputBand = 0.01;
+bool OutputBandPassedOnBothSides(const EffectBlock& b, const AugmentedModel& m, const Vec& u, std::size_t skip) {
+  if (b.effect != Effect::kDeadzone || b.location != Location::kOutput) return true;
+  AugmentedModel before = m;
+  before.blocks.erase(std::remove_if(before.blocks.begin(), before.blocks.end(),
+                                     [](const EffectBlock& x) { return x.location == Location::kOutput; }),
+                      before.blocks.end());
+  const Vec v = before.simulate(u);
+  const Vec scored(v.begin() + std::min(skip, v.size()), v.end());
+  return SmallerShareBeyondBand(scored, b.params[1], b.params[0]) >= kMinShareBeyondEachEdgeOfOutputBand;
+}
+
 // A saturation-type block's limits are chosen on the fitting part, which may not show them as the whole
 // recording does: the other limit may be reached only later (retired seed 1 400 193, PRBS: the output's
 // lower limit is reached in the held-out tail and on validation, not in the fitting part; the one-sided fit
@@ -841,6 +858,8 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
     for (const auto& b : *blocks)
       if (b.location != Location::kState)
         meaningful = meaningful && PhysicallyMeaningful(b, b.location == Location::kInput ? c.ident.u : c.ident.y, c.skip);
+  for (const auto* m : {&f.fitted, &f.model})
+    for (const auto& b : m->blocks) meaningful = meaningful && OutputBandPassedOnBothSides(b, *m, c.ident.u, c.skip);
   // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
   // the fitting part): a candidate that validation confirms may then pass the first test with the
   // recordings' roles swapped instead (refitted on the validation recording, scored on the whole

@@ -670,5 +670,20 @@ TEST(OpenStudy, ALimitTheFittingPartFitNeverPlacedDoesNotJudgeTheTail) {
                     Location::kOutput));
 }
 
+// An output dead band whose input never passes beyond its lower edge is a lower output saturation with its
+// offset moved by the half-width, one parameter more. Development seed 1 500 996 (multisine, hw:3,1,1,3,0,
+// output saturation): the band (centre -0.903, half-width 0.696) sat at the bottom of a skewed output
+// whose median lies within a quarter of the spread of its centre, so the median test called it central,
+// and it was named (validation 0.627x against the saturation's 0.662x).
+TEST(OpenStudy, AnOutputDeadBandPassedOnOneSideOnlyIsAClamp) {
+  const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1500996);
+  EXPECT_TRUE(Names(r, Effect::kSaturation, Location::kOutput));
+  const auto band = std::find_if(r.findings.begin(), r.findings.end(), [](const Finding& f) {
+    return f.blocks.size() == 1 && f.blocks[0].effect == Effect::kDeadzone && f.blocks[0].location == Location::kOutput;
+  });
+  ASSERT_NE(band, r.findings.end());
+  EXPECT_FALSE(band->meaningful) << band->evidence;
+}
+
 }  // namespace
 }  // namespace hw::diagnose
