@@ -401,6 +401,16 @@ TEST(OpenStudy, OutputQuantizerContinuationStartsFromHalfAStep) {
                     Location::kOutput));
 }
 
+// An output quantizer seen through few levels (development seed 1 500 856, PRBS, linear:2,2,1, nominal
+// given): the fit found the step (0.398 against the true 0.399) and halved the held-out error, but stopped
+// with a gain and offset before the quantizer that the identification recording cannot tell from the
+// truth's and validation rejected (1.76x the baseline's error). The gains and offsets of the quantizer's
+// argument that predict the identification recording alike are judged on validation.
+TEST(OpenStudy, OutputQuantizerArgumentAmongTheIdentificationTiesIsJudgedOnValidation) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1500856), Effect::kQuantization,
+                    Location::kOutput));
+}
+
 // An output dead band at 0 on an output whose median is far from 0 (retired seed 1 100 174, filtered
 // noise, hw:1,1,3,1,0 with a cubic input map, nominal given): the fit found the band (half-width 0.0144
 // against the true 0.0145) and removed three quarters of the held-out error, but the band sat 0.25 of
