@@ -637,15 +637,21 @@ bool CentreInTies(AugmentedModel* m, std::size_t b, std::size_t i, const Vec& va
   return CentreInTies(m, set, values, s, o, rule);
 }
 
+// The step of the model's output quantizer; 0 when it has none.
+double OutputQuantizerStep(const AugmentedModel& m) {
+  double q = 0.0;
+  for (const auto& b : m.blocks)
+    if (b.effect == Effect::kQuantization && b.location == Location::kOutput) q = b.params[0];
+  return q;
+}
+
 // Under an output quantizer the output offset (added before the quantizer) moves the simulated output
 // by whole steps at a time: its cost is a staircase that LM cannot descend, and an offset carried over
 // from the nominal fit (which averaged the steps) can sit a fraction of a step from the truth. It is
 // searched over one step around its value (quantizer held), the middle of a tie kept. Returns whether
 // the model has such a quantizer (and the offset was searched).
 bool SearchOffsetUnderOutputQuantizer(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
-  double q = 0.0;
-  for (const auto& b : m->blocks)
-    if (b.effect == Effect::kQuantization && b.location == Location::kOutput) q = b.params[0];
+  const double q = OutputQuantizerStep(*m);
   if (!(q > 0) || !o.fit_output_offset) return false;
   const auto set_offset = [](AugmentedModel* t, double v) {
     t->output_offset = v;
@@ -814,6 +820,25 @@ void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOption
     any = true;
   }
   if (any) Lm(m, Packing::For(*m, o), s, o.lm);
+}
+
+// An output quantizer's step and grid offset searched first are searched with the nominal part as it
+// came, which may be far off (a baseline biased by the levels, or by feedback in closed loop): the
+// search then leaves the start's step for one that suits those numbers. When it left it by more than
+// twice the spacing of the steps the start was read on, the nominal part is also refitted under the
+// quantizer as started (offset search and continuation) before the search, and the order whose fit
+// costs less on the data is kept.
+constexpr double kOutputLevelStepLeft = 0.02;
+
+void SearchOnlyParametersAlsoQuantizerHeld(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  AugmentedModel held = *m;
+  const double start_step = OutputQuantizerStep(held);
+  SearchOnlyParameters(m, s, o);
+  if (!(std::abs(OutputQuantizerStep(*m) - start_step) > kOutputLevelStepLeft * start_step)) return;
+  if (!SearchOffsetUnderOutputQuantizer(&held, s, o)) return;
+  RefitUnderSmoothedOutputQuantizer(&held, s, o);
+  SearchOnlyParameters(&held, s, o);
+  if (SumSquaredError(held, s) < SumSquaredError(*m, s)) *m = held;
 }
 
 RefitResult Finish(const AugmentedModel& m, const Segment& s) {
@@ -1085,9 +1110,11 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   // An output quantizer's levels read from the measured output are refined in any case (their score
   // with the nominal's numbers can be poor when its offset sits a fraction of a step off).
+  std::size_t level_starts = 0;
   if (effect == Effect::kQuantization && location == Location::kOutput) {
     const double range = std::max(Quantile(yhat, 1.0) - Quantile(yhat, 0.0), 1e-12);
     for (const Vec& p : OutputLevelStarts(*s.y, s.skip, s.End(), range)) {
+      ++level_starts;
       AugmentedModel m = base;
       m.blocks.push_back({effect, location, p, sv});
       if (o.estimate_initial_state) m.initial_state.resize(m.nominal.linear.a.size(), 0.0);
@@ -1114,10 +1141,16 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   if (resolved.size() > kResolvedPointsRefined) resolved.resize(kResolvedPointsRefined);
   for (auto& r : resolved) scored.insert(scored.begin(), std::move(r));
   const int keep = std::min<int>(refine + static_cast<int>(resolved.size()), static_cast<int>(scored.size()));
+  // The output levels' starts follow the re-solved ones: their steps are read from the data, not fitted to
+  // the nominal's numbers, and are also refined with the nominal part refitted under them first.
+  const auto is_level_start = [&](int i) {
+    return static_cast<std::size_t>(i) >= resolved.size() && static_cast<std::size_t>(i) < resolved.size() + level_starts;
+  };
   for (int i = 0; i < keep; ++i) {
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);
-    SearchOnlyParameters(&m, s, o);
+    if (is_level_start(i)) SearchOnlyParametersAlsoQuantizerHeld(&m, s, o);
+    else SearchOnlyParameters(&m, s, o);
     RefitResult r = Finish(m, s);
     if (r.sse < best.sse) best = r;
   }
