@@ -5,6 +5,7 @@
 #include <complex>
 #include <limits>
 #include <numeric>
+#include <set>
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
@@ -803,6 +804,24 @@ void SearchBlockParameters(AugmentedModel* m, const Segment& s, const RefitOptio
     }
 }
 
+// An input quantizer's grid points are ranked with the baseline's numbers, fitted to the input without
+// it: a fine step changes that input least and ranks first, while a coarse step's points (the true one's
+// among them) can rank hundreds of places down; every point refined then sits at a fraction of the true
+// step, and its refined fit stays above the true step's. Within a band of alike steps the ranking is a
+// fair guide, so the best point of every band of steps a factor kQuantizerStepBand wide that the kept
+// points leave out is refined too. Returns the new number of kept points (the first ones of *scored).
+constexpr double kQuantizerStepBand = 1.5;
+int KeepBestOfEveryStepBand(std::vector<std::pair<double, AugmentedModel>>* scored, int keep) {
+  const auto band = [scored](std::size_t i) {
+    return std::lround(std::floor(std::log((*scored)[i].second.blocks.back().params[0]) / std::log(kQuantizerStepBand)));
+  };
+  std::set<long> seen;
+  for (int i = 0; i < keep; ++i) seen.insert(band(i));
+  for (std::size_t i = keep; i < scored->size(); ++i)
+    if (seen.insert(band(i)).second) std::swap((*scored)[keep++], (*scored)[i]);
+  return keep;
+}
+
 // Under an output quantizer, the offset search and the smoothed refit move the numbers the quantizer's
 // step and grid offset were searched with: those are searched once more.
 void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
@@ -1113,7 +1132,8 @@ RefitResult AddBlock(const AugmentedModel& base, Effect effect, Location locatio
   std::sort(resolved.begin(), resolved.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   if (resolved.size() > kResolvedPointsRefined) resolved.resize(kResolvedPointsRefined);
   for (auto& r : resolved) scored.insert(scored.begin(), std::move(r));
-  const int keep = std::min<int>(refine + static_cast<int>(resolved.size()), static_cast<int>(scored.size()));
+  int keep = std::min<int>(refine + static_cast<int>(resolved.size()), static_cast<int>(scored.size()));
+  if (effect == Effect::kQuantization && location == Location::kInput) keep = KeepBestOfEveryStepBand(&scored, keep);
   for (int i = 0; i < keep; ++i) {
     AugmentedModel m = scored[i].second;
     Lm(&m, Packing::For(m, o), s, o.lm);
