@@ -573,6 +573,18 @@ TEST(OpenStudy, InputQuantizerRefinesTheBestGridPointOfEveryBandOfSteps) {
         << (fitted ? "fitted" : "given");
 }
 
+// Development seed 1 500 402 (closed loop, an input quantizer): the refined fits stopped beside the true
+// step and grid offset, whose optimum is narrow in both jointly, and neither the held-out tail nor
+// validation confirmed the quantizer (the nominal fit was reported failed). Refitted by continuation
+// (rounding smoothed over a quarter of a step down to a fiftieth, step and grid offset moved with every
+// other number), the fit reaches it and the quantizer is named.
+TEST(OpenStudy, InputQuantizerStepAndOffsetAreRefittedWithTheRoundingSmoothed) {
+  for (bool fitted : {false, true})
+    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1500402, fitted), Effect::kQuantization,
+                      Location::kInput))
+        << (fitted ? "fitted" : "given");
+}
+
 // An output dead band on a PRBS response (retired seed 1 400 461, linear:3,3,2, half-width 0.197, 9.6 noise
 // standard deviations): the output crosses the band quickly, so the cost has many local optima in the
 // band's centre and width; the refined grid points stopped at a centre 0.25 from the true one (2.3 times
