@@ -437,8 +437,14 @@ AugmentedModel AugmentedModel::WithoutBlocks() const {
 
 std::vector<double> AugmentedModel::AfterInputBlocks(const std::vector<double>& u) const {
   std::vector<double> x = u;
-  for (const auto& b : blocks)
-    if (b.location == Location::kInput) x = ApplyInputBlock(b, x);
+  for (const auto& b : blocks) {
+    if (b.location != Location::kInput) continue;
+    if (b.effect == Effect::kQuantization && input_quantizer_smoothing > 0) {
+      for (auto& v : x) v = ApplyStaticBlock(b, v, input_quantizer_smoothing);
+    } else {
+      x = ApplyInputBlock(b, x);
+    }
+  }
   return x;
 }
 

@@ -99,6 +99,7 @@ struct AugmentedModel {
   // Width (in steps) of a smooth rounding used for output quantizers while an optimiser moves the other
   // numbers (0: the exact staircase). Never written or read: a fitting aid only (see refit.cpp).
   double output_quantizer_smoothing = 0.0;
+  double input_quantizer_smoothing = 0.0;  // the same for input quantizers
 
   bool has_block() const { return !blocks.empty(); }
   Effect effect() const { return blocks.empty() ? Effect::kNone : blocks.front().effect; }
