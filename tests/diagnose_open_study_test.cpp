@@ -257,6 +257,14 @@ DiagnoseReport DiagnoseWithNominalFitted(Effect effect, Location location, unsig
   return ::testing::AssertionFailure() << r.message;
 }
 
+// The scenario of `seed` names its input quantizer with the nominal given and with it fitted.
+void ExpectInputQuantizerNamedWithEitherNominal(unsigned seed) {
+  for (bool fitted : {false, true})
+    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, seed, fitted), Effect::kQuantization,
+                      Location::kInput))
+        << (fitted ? "fitted" : "given");
+}
+
 // A null recording whose fitted nominal stays stuck in a poor optimum (held-out RMSE 2.2x the noise): the
 // refit of an input quantizer of a small step freed the nominal part under it, which alone (the block
 // removed) reaches the noise, and was named as an effect. The blocks must make the difference, otherwise
@@ -500,10 +508,7 @@ TEST(OpenStudy, InputMapShapeUnderAStateSaturationIsJudgedOnValidation) {
 // recording alike; the search among ties reached only the steps within 3 % with the offset scaled along,
 // and validation rejected the fit (1.95x the baseline's error). Both nominals.
 TEST(OpenStudy, InputQuantizerGridsThatIndexTheSamplesAlikeAreJudgedOnValidation) {
-  for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1300078, fitted), Effect::kQuantization,
-                      Location::kInput))
-        << (fitted ? "fitted" : "given");
+  ExpectInputQuantizerNamedWithEitherNominal(1300078);
 }
 
 // An input dead band in a gap between two levels of a step input (retired seeds 1 300 200, hw:2,1,3,1,0,
@@ -561,10 +566,7 @@ TEST(OpenStudy, OutputAndStateSaturationAreSettledByTheirPredictionDifference) {
 // scored after the Gauss-Newton re-solve through the map, the true step's points rank first, and the
 // best 3 so scored are refined besides the 12 (identification fit 0.454 against 0.977 on the fitting part).
 TEST(OpenStudy, InputQuantizerGridUnderAPolynomialOutputMapIsScoredAfterAReSolveThroughTheMap) {
-  for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1300168, fitted), Effect::kQuantization,
-                      Location::kInput))
-        << (fitted ? "fitted" : "given");
+  ExpectInputQuantizerNamedWithEitherNominal(1300168);
 }
 
 // Development seed 1 500 114 (steps, hw:3,3,3,1,2, a cubic input map, true step 0.172): scored with the
@@ -574,10 +576,7 @@ TEST(OpenStudy, InputQuantizerGridUnderAPolynomialOutputMapIsScoredAfterAReSolve
 // nominal fit was reported failed. Scored after re-solving the map with the numerator, the grid points of
 // the true grid (up to a scaling the map absorbs) rank among the best and the quantizer is named.
 TEST(OpenStudy, InputQuantizerGridUnderAPolynomialInputMapIsScoredWithTheMapReSolved) {
-  for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1500114, fitted), Effect::kQuantization,
-                      Location::kInput))
-        << (fitted ? "fitted" : "given");
+  ExpectInputQuantizerNamedWithEitherNominal(1500114);
 }
 
 // Development seed 1 500 506 (steps, hw:1,3,1,3,0, a cubic output map, true step 0.442): ranked with the
@@ -587,10 +586,7 @@ TEST(OpenStudy, InputQuantizerGridUnderAPolynomialInputMapIsScoredWithTheMapReSo
 // failed. With the best point of every band of steps a factor 1.5 wide refined too, the refined fits
 // reach the true step's cost and the quantizer is named.
 TEST(OpenStudy, InputQuantizerRefinesTheBestGridPointOfEveryBandOfSteps) {
-  for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1500506, fitted), Effect::kQuantization,
-                      Location::kInput))
-        << (fitted ? "fitted" : "given");
+  ExpectInputQuantizerNamedWithEitherNominal(1500506);
 }
 
 // Development seed 1 500 402 (closed loop, an input quantizer): the refined fits stopped beside the true
@@ -599,10 +595,7 @@ TEST(OpenStudy, InputQuantizerRefinesTheBestGridPointOfEveryBandOfSteps) {
 // (rounding smoothed over a quarter of a step down to a fiftieth, step and grid offset moved with every
 // other number), the fit reaches it and the quantizer is named.
 TEST(OpenStudy, InputQuantizerStepAndOffsetAreRefittedWithTheRoundingSmoothed) {
-  for (bool fitted : {false, true})
-    EXPECT_TRUE(Names(DiagnoseScenario(Effect::kQuantization, Location::kInput, 1500402, fitted), Effect::kQuantization,
-                      Location::kInput))
-        << (fitted ? "fitted" : "given");
+  ExpectInputQuantizerNamedWithEitherNominal(1500402);
 }
 
 // An output dead band on a PRBS response (retired seed 1 400 461, linear:3,3,2, half-width 0.197, 9.6 noise
