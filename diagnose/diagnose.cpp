@@ -1219,22 +1219,23 @@ bool BlocksActOnFittingPart(const Context& c, const AugmentedModel& fitted) {
   return false;
 }
 
-// Stiction and backlash differ only where the stem sticks and then slips (the jump); elsewhere their
-// predictions agree, and the whole-recording scores of two eligible fits are often tied within the
-// extra parameter's penalty. On the data neither fit was fitted on (validation, and the held-out tail for
-// the fits on the fitting part), the backlash residual is regressed on the difference of the two predictions, d = yhat_stiction - yhat_backlash: the coefficient is near 1 when the jump is in the
-// data and near 0 when it is not, and e_b^2 - e_s^2 summed is 2 <e_b, d> - <d, d>, so 0.5 is where the
-// two fit equally. Returns (coefficient - 0.5) / its standard error (the stiction residual's RMS over
-// |d|); 0 when the predictions do not differ. `share` gets the coefficient.
-double StickSlipZ(const Context& c, const Finding& backlash, const Finding& stiction, double* share) {
+// Two eligible findings whose whole-recording scores tie within the penalty can differ only in a few
+// episodes: stiction and backlash only where the stem sticks and then slips (the jump), an output and a
+// state saturation only after a clip ends. On the data neither fit was fitted on (validation, and the
+// held-out tail for the fits on the fitting part), `a`'s residual is regressed on the difference of the two
+// predictions, d = yhat_b - yhat_a: the coefficient is near 1 when the data hold what `b` adds and near 0
+// when they do not, and e_a^2 - e_b^2 summed is 2 <e_a, d> - <d, d>, so 0.5 is where the two fit equally.
+// Returns (coefficient - 0.5) / its standard error (`b`'s residual RMS over |d|); 0 when the predictions do
+// not differ. `share` gets the coefficient.
+double UnseenDataDifferenceZ(const Context& c, const Finding& a, const Finding& b, double* share) {
   DifferenceRegression r;
-  r.Add(c.ValidationResidual(backlash.model), c.ValidationResidual(stiction.model), c.skip, c.nv);
+  r.Add(c.ValidationResidual(a.model), c.ValidationResidual(b.model), c.skip, c.nv);
   // The fits on the fitting part count only where the held-out tail judged them and where both placed their
   // blocks: a finding that passed by the roles-swapped test, or whose limit the fitting part does not
   // reach, may have a fit there that clips nothing, and its residual on the tail is then the baseline's.
-  if (!backlash.swapped_stands_in && !stiction.swapped_stands_in && BlocksActOnFittingPart(c, backlash.fitted) &&
-      BlocksActOnFittingPart(c, stiction.fitted))
-    r.Add(c.IdentResidual(backlash.fitted), c.IdentResidual(stiction.fitted), c.nfit, c.n);
+  if (!a.swapped_stands_in && !b.swapped_stands_in && BlocksActOnFittingPart(c, a.fitted) &&
+      BlocksActOnFittingPart(c, b.fitted))
+    r.Add(c.IdentResidual(a.fitted), c.IdentResidual(b.fitted), c.nfit, c.n);
   *share = r.Share();
   return r.Z();
 }
@@ -1260,7 +1261,7 @@ Finding* EligibleSingle(std::vector<Finding>* fs, Effect effect, std::optional<L
   return found;
 }
 
-// Which of two eligible findings the difference of their predictions on unseen data favours (StickSlipZ,
+// Which of two eligible findings the difference of their predictions on unseen data favours (UnseenDataDifferenceZ,
 // `a`'s residual regressed on it): the one favoured significantly (|z| >= 2) is ranked first, otherwise the
 // ranking by penalised score stands.
 enum class PairVerdict { kFirst, kSecond, kTie };
@@ -1278,7 +1279,7 @@ PairVerdict RankByZ(double z, Finding* a, Finding* b) {
 }
 
 PairVerdict RankByPredictionDifference(const Context& c, Finding* a, Finding* b, double* z, double* share) {
-  *z = StickSlipZ(c, *a, *b, share);
+  *z = UnseenDataDifferenceZ(c, *a, *b, share);
   return RankByZ(*z, a, b);
 }
 
@@ -1306,7 +1307,7 @@ void SettleStictionBacklash(const Context& c, std::vector<Finding>* fs) {
 // and a state saturation clip the same samples and differ only in how the output leaves the limit (the
 // state saturation's block recovers at once, the output's follows the unclipped state). As for stiction
 // and backlash, the first one's residual on unseen data is
-// regressed on the difference of the two predictions (StickSlipZ): when the coefficient differs from 0.5
+// regressed on the difference of the two predictions (UnseenDataDifferenceZ): when the coefficient differs from 0.5
 // by at least 2 standard errors, the one it favours is ranked first. Unseen data may show no episode
 // after which the two differ (a limit validation never reaches, episodes only in the fitting part); on a
 // tie there the same regression over the whole identification recording (WholeRecordingDifferenceZ)
