@@ -437,12 +437,10 @@ TEST(Refit, TheOffsetUnderAnOutputQuantizerIsSearchedNotLeftWhereTheNominalPutIt
   EXPECT_LT(r.sse, SumSquaredError(start, seg));
 }
 
-// Under a polynomial output map the output is not linear in the numerator, offset and initial state; the
-// Gauss-Newton re-solve through the map (poles held) recovers them from a start far off.
 // The set-up the re-solves of the numerator (with a map or a block around it) share: a first-order system
 // (b = 0.4, 0.2) driven by filtered noise with noise 0.01, and a start whose numerator, offset and initial
 // state are far off.
-AugmentedModel FirstOrderTruth(long delay = 0) {
+AugmentedModel FirstOrderTruth(int delay = 0) {
   AugmentedModel truth;
   truth.nominal.linear = {{-0.6}, {0.4, 0.2}, delay};
   return truth;
@@ -477,6 +475,8 @@ void ExpectNumeratorAndOffsetRecovered(const ReSolveCase& c, double offset, doub
   EXPECT_LT(SumSquaredError(c.start, seg), 1.5 * 600 * 0.01 * 0.01);
 }
 
+// Under a polynomial output map the output is not linear in the numerator, offset and initial state; the
+// Gauss-Newton re-solve through the map (poles held) recovers them from a start far off.
 TEST(Refit, NumeratorOffsetAndInitialStateAreReSolvedThroughAPolynomialOutputMap) {
   AugmentedModel truth = FirstOrderTruth();
   truth.nominal.output = StaticMap::Polynomial({1.0, 0.0, 0.3});
