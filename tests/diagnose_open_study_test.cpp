@@ -257,6 +257,11 @@ DiagnoseReport DiagnoseWithNominalFitted(Effect effect, Location location, unsig
   return ::testing::AssertionFailure() << r.message;
 }
 
+// The scenario of `seed` diagnosed with its nominal given names `effect` at `location`.
+::testing::AssertionResult NamedWithNominalGiven(Effect effect, Location location, unsigned seed) {
+  return Names(DiagnoseWithNominalGiven(effect, location, seed), effect, location);
+}
+
 // The scenario of `seed` names its input quantizer with the nominal given and with it fitted.
 void ExpectInputQuantizerNamedWithEitherNominal(unsigned seed) {
   for (bool fitted : {false, true})
@@ -353,8 +358,7 @@ TEST(OpenStudy, DelayAgainstARicherNumeratorAndEffectsOutsideTheHeldOutTail) {
 // input is one of its levels, so no finite limit was tried, and hysteresis with a threshold never
 // crossed (a constant input offset) was named instead.
 TEST(OpenStudy, InputSaturationOnATwoLevelInput) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kSaturation, Location::kInput, 800111), Effect::kSaturation,
-                    Location::kInput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kSaturation, Location::kInput, 800111));
 }
 
 // A relay in a closed loop (retired seed 800 314, linear:2,2,1): the reference steps make the input jump
@@ -363,8 +367,7 @@ TEST(OpenStudy, InputSaturationOnATwoLevelInput) {
 // relay worse than none (MSE 1.23x the baseline's) and the fit was called failed. The tail now judges
 // the best threshold among those the fitting part cannot tell apart.
 TEST(OpenStudy, RelayThresholdAmongTheFittingPartsTiesIsJudgedOnTheHeldOutTail) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kHysteresis, Location::kInput, 800314), Effect::kHysteresis,
-                    Location::kInput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kHysteresis, Location::kInput, 800314));
 }
 
 // Stiction in a closed loop (retired seed 900 460, linear:1,1,2, nominal given): the coarse joint grid of
@@ -372,8 +375,7 @@ TEST(OpenStudy, RelayThresholdAmongTheFittingPartsTiesIsJudgedOnTheHeldOutTail) 
 // (every break-away a sample early or late), the fit stayed at (0.323, 0.226), and backlash was named.
 // The best coarse pairs are now refined on finer grids of both bands.
 TEST(StictionFit, BandsBetweenCoarseGridPointsAreRefined) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kStiction, Location::kInput, 900460), Effect::kStiction,
-                    Location::kInput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kStiction, Location::kInput, 900460));
 }
 
 // Stiction whose identification recording never sticks and slips between the kinetic band and static
@@ -382,8 +384,7 @@ TEST(StictionFit, BandsBetweenCoarseGridPointsAreRefined) {
 // 65 noise standard deviations that backlash leaves. Validation now judges the static band among the
 // identification recording's ties.
 TEST(OpenStudy, StaticBandAmongTheIdentificationTiesIsJudgedOnValidation) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kStiction, Location::kInput, 900119), Effect::kStiction,
-                    Location::kInput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kStiction, Location::kInput, 900119));
 }
 
 // Input quantizers on steps (retired seeds 1 000 114, linear:1,3,1, and 1 000 186, linear:3,3,0; nominal
@@ -405,8 +406,7 @@ TEST(OpenStudy, InputQuantizerStepAndOffsetAmongTiesAreJudgedOnUnseenData) {
 // the quantizer; started at half a step, with a twentieth before the exact staircase, it reaches one
 // validation confirms.
 TEST(OpenStudy, OutputQuantizerContinuationStartsFromHalfAStep) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1000302), Effect::kQuantization,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kQuantization, Location::kOutput, 1000302));
 }
 
 // An output quantizer seen through few levels (development seed 1 500 856, PRBS, linear:2,2,1, nominal
@@ -415,8 +415,7 @@ TEST(OpenStudy, OutputQuantizerContinuationStartsFromHalfAStep) {
 // truth's and validation rejected (1.76x the baseline's error). The gains and offsets of the quantizer's
 // argument that predict the identification recording alike are judged on validation.
 TEST(OpenStudy, OutputQuantizerArgumentAmongTheIdentificationTiesIsJudgedOnValidation) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1500856), Effect::kQuantization,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kQuantization, Location::kOutput, 1500856));
 }
 
 // An output quantizer in closed loop (development seed 1 500 568, linear:2,2,0, nominal given): the levels
@@ -425,8 +424,7 @@ TEST(OpenStudy, OutputQuantizerArgumentAmongTheIdentificationTiesIsJudgedOnValid
 // step with a grid offset between the true levels (held-out 0.76x, validation 0.72x, the nominal's fit
 // reported as failed). Refitted under the levels as read first, the fit keeps the true step.
 TEST(OpenStudy, OutputQuantizerLevelsReadFromTheDataAreHeldWhileTheNominalPartIsRefitted) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1500568), Effect::kQuantization,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kQuantization, Location::kOutput, 1500568));
 }
 
 // An output dead band at 0 on an output whose median is far from 0 (retired seed 1 100 174, filtered
@@ -436,8 +434,7 @@ TEST(OpenStudy, OutputQuantizerLevelsReadFromTheDataAreHeldWhileTheNominalPartIs
 // as physically meaningless (verdict none, fit failed). A fifth of the samples lie above the band and
 // three quarters below it: the band sits inside the data, not at its edge like a clamp.
 TEST(OpenStudy, DeadBandInsideASkewedSignalIsMeaningful) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kDeadzone, Location::kOutput, 1100174), Effect::kDeadzone,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kDeadzone, Location::kOutput, 1100174));
 }
 
 // An output saturation reached in one stretch of the held-out tail (retired seed 1 100 049, multisine,
@@ -468,8 +465,7 @@ TEST(OpenStudy, RateLimitGridPointsRankedByTheBaselineAreRefinedWellInsideTheJum
 // re-solved the numerator, which a non-identity output map does not allow, so none was tried. Scaling the
 // grid and composing the input map with the inverse scaling predicts alike; validation judges the ties.
 TEST(OpenStudy, InputQuantizerTiesUnderANonlinearMapAreJudgedOnValidation) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kInput, 1300258), Effect::kQuantization,
-                    Location::kInput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kQuantization, Location::kInput, 1300258));
 }
 
 // An output quantizer under a cubic input map on a two-level input (retired seed 1 300 374, PRBS,
@@ -478,8 +474,7 @@ TEST(OpenStudy, InputQuantizerTiesUnderANonlinearMapAreJudgedOnValidation) {
 // rejected it (2.69x the baseline's error). The model with the baseline's map shape matched at the two
 // levels predicts the identification recording alike, and validation judges the two.
 TEST(OpenStudy, InputMapShapeLeftFreeByATwoLevelInputIsJudgedOnValidation) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kQuantization, Location::kOutput, 1300374), Effect::kQuantization,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kQuantization, Location::kOutput, 1300374));
 }
 
 // The same freedom under any block the two-level input passes through unchanged (development seeds of
@@ -552,8 +547,7 @@ TEST(OpenStudy, WholeRecordingRefitAlsoStartsFromTheValueChosenAmongFittingTies)
 // errors; in 1 300 229 (filtered noise, linear:1,1,2) the two predict alike (0.256x / 0.261x held-out,
 // 0.632x / 0.633x validation) and the report says they tie.
 TEST(OpenStudy, OutputAndStateSaturationAreSettledByTheirPredictionDifference) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1300067), Effect::kSaturation,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kSaturation, Location::kOutput, 1300067));
   const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1300229);
   ASSERT_FALSE(r.findings.empty());
   EXPECT_NE(r.findings.front().evidence.find("saturation@output and state_saturation@state tie"), std::string::npos)
@@ -704,8 +698,7 @@ TEST(OpenStudy, OutputAndStateSaturationTiedOnUnseenDataAreSettledOnTheIdentific
 // (the baseline on the tail), the state saturation's at -6.53, and the tail's clipping episode favoured the
 // state saturation by 8.6 standard errors. Validation alone favours the output saturation (z = 2.7).
 TEST(OpenStudy, ALimitTheFittingPartFitNeverPlacedDoesNotJudgeTheTail) {
-  EXPECT_TRUE(Names(DiagnoseWithNominalGiven(Effect::kSaturation, Location::kOutput, 1500657), Effect::kSaturation,
-                    Location::kOutput));
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kSaturation, Location::kOutput, 1500657));
 }
 
 // An output dead band whose input never passes beyond its lower edge is a lower output saturation with its
