@@ -884,6 +884,55 @@ void DelayFromFreshStarts(const Context& c, const Reference& ref, Finding* f) {
   f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(m), c.nfit, c.n, f->extra_parameters, c.o.significance_z);
 }
 
+// Both fits must describe a device: the one judged on the held-out tail and the one judged on validation
+// and named (retired seed 1 400 479, steps: a narrow band in the middle of the output on the fitting part,
+// refitted on the whole recording into a band centred at an output saturation's limit, i.e. a clamp).
+bool FitsMeaningful(const Context& c, const Finding& f) {
+  bool meaningful = true;
+  for (const auto* blocks : {&f.blocks, &f.model.blocks})
+    for (const auto& b : *blocks)
+      if (b.location != Location::kState)
+        meaningful = meaningful && PhysicallyMeaningful(b, b.location == Location::kInput ? c.ident.u : c.ident.y, c.skip);
+  for (const auto* m : {&f.fitted, &f.model})
+    for (const auto& b : m->blocks) meaningful = meaningful && OutputBandPassedOnBothSides(b, *m, c.ident.u, c.skip);
+  return meaningful;
+}
+
+// The tests a candidate with its two fits and their comparisons (held-out tail, validation) in place must
+// pass: its score and eligibility.
+void JudgeCandidate(const Context& c, const Reference& ref, Finding* fp) {
+  Finding& f = *fp;
+  f.swapped_tested = f.swapped_stands_in = false;
+  // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
+  // the fitting part): a candidate that validation confirms may then pass the first test with the
+  // recordings' roles swapped instead (refitted on the validation recording, scored on the whole
+  // identification recording against the reference refitted there). Both recordings then judge models
+  // fitted on the other one, which also rewards a better optimum of a poorly determined nominal (a
+  // cubic input map under a two-level input): this path asks for a large penalised reduction on both.
+  Comparison first = f.holdout;
+  if (!f.holdout.significant && f.validation.significant && f.validation.score >= c.o.swapped_min_improvement &&
+      !ref.swapped_residual.empty()) {
+    const AugmentedModel swapped = c.SwappedModel(f.model);
+    f.swapped = c.Compare(ref.swapped_residual, c.IdentResidual(swapped), c.skip, c.n, f.extra_parameters,
+                          c.o.validation_z);
+    f.swapped_tested = true;
+    f.swapped_stands_in = f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement &&
+                          SwappedBlocksNeeded(c, swapped) && SeenOnIdentification(c, ref, f);
+    if (f.swapped_stands_in) first = f.swapped;
+  }
+  const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
+  f.score = 1.0 - std::sqrt(ph * pv);
+  // Robust to the nominal: the block must also do better than a richer nominal on the held-out tail.
+  const bool holdout_beats_richer =
+      first.score >= ref.richer_score ||
+      (!f.swapped_stands_in &&
+       ref.best_richer >= 0 &&
+       TiedWithRicherAndBetterOnValidation(c, ref.richer[ref.best_richer], c.IdentResidual(f.fitted), f.extra_parameters,
+                                           f.validation.score));
+  f.beats_richer = holdout_beats_richer && f.validation.score >= ref.richer_validation_score;
+  f.eligible = first.significant && f.validation.significant && f.beats_richer && f.meaningful;
+}
+
 Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
   // Saturation-type blocks: one-sided and two-sided limits are different structures, chosen by the
   // penalised held-out score (a second limit must earn its parameter).
@@ -916,45 +965,8 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   if (!f.holdout.significant) ChooseTiedValueAmongFittingTies(c, ref, &f);
   if (f.holdout.significant && !f.validation.significant) ChooseTiedValueAmongIdentificationTies(c, ref, &f);
   ChooseStaticBandAmongTies(c, ref, &f);
-  // Both fits must describe a device: the one judged on the held-out tail and the one judged on validation
-  // and named (retired seed 1 400 479, steps: a narrow band in the middle of the output on the fitting part,
-  // refitted on the whole recording into a band centred at an output saturation's limit, i.e. a clamp).
-  bool meaningful = true;
-  for (const auto* blocks : {&f.blocks, &f.model.blocks})
-    for (const auto& b : *blocks)
-      if (b.location != Location::kState)
-        meaningful = meaningful && PhysicallyMeaningful(b, b.location == Location::kInput ? c.ident.u : c.ident.y, c.skip);
-  for (const auto* m : {&f.fitted, &f.model})
-    for (const auto& b : m->blocks) meaningful = meaningful && OutputBandPassedOnBothSides(b, *m, c.ident.u, c.skip);
-  // The held-out tail may hold nothing of what the effect does (a limit or a step level reached only in
-  // the fitting part): a candidate that validation confirms may then pass the first test with the
-  // recordings' roles swapped instead (refitted on the validation recording, scored on the whole
-  // identification recording against the reference refitted there). Both recordings then judge models
-  // fitted on the other one, which also rewards a better optimum of a poorly determined nominal (a
-  // cubic input map under a two-level input): this path asks for a large penalised reduction on both.
-  Comparison first = f.holdout;
-  if (!f.holdout.significant && f.validation.significant && f.validation.score >= c.o.swapped_min_improvement &&
-      !ref.swapped_residual.empty()) {
-    const AugmentedModel swapped = c.SwappedModel(f.model);
-    f.swapped = c.Compare(ref.swapped_residual, c.IdentResidual(swapped), c.skip, c.n, f.extra_parameters,
-                          c.o.validation_z);
-    f.swapped_tested = true;
-    f.swapped_stands_in = f.swapped.significant && f.swapped.score >= c.o.swapped_min_improvement &&
-                          SwappedBlocksNeeded(c, swapped) && SeenOnIdentification(c, ref, f);
-    if (f.swapped_stands_in) first = f.swapped;
-  }
-  const double ph = std::max(1.0 - first.score, 1e-12), pv = std::max(1.0 - f.validation.score, 1e-12);
-  f.score = 1.0 - std::sqrt(ph * pv);
-  // Robust to the nominal: the block must also do better than a richer nominal on the held-out tail.
-  const bool holdout_beats_richer =
-      first.score >= ref.richer_score ||
-      (!f.swapped_stands_in &&
-       ref.best_richer >= 0 &&
-       TiedWithRicherAndBetterOnValidation(c, ref.richer[ref.best_richer], c.IdentResidual(f.fitted), f.extra_parameters,
-                                           f.validation.score));
-  f.beats_richer = holdout_beats_richer && f.validation.score >= ref.richer_validation_score;
-  f.meaningful = meaningful;
-  f.eligible = first.significant && f.validation.significant && f.beats_richer && meaningful;
+  f.meaningful = FitsMeaningful(c, f);
+  JudgeCandidate(c, ref, &f);
   return f;
 }
 
@@ -1383,6 +1395,38 @@ std::vector<Finding> SearchPairs(const Context& c, const Finding& single, const 
   return out;
 }
 
+// A pair's fit can reach a better optimum of its second block than that block's own fits did: a state
+// saturation fitted alone with one limit finds the other one under an output saturation, which then clips
+// almost nothing the state's limits leave (the pair's refit on the whole recording puts both blocks' limits
+// at the same outputs). The pair's numbers for the partner's block, the first block removed, are then one
+// more start of the partner's two fits; each refit is kept only when it lowers the cost on its own training
+// data (the fitting part, the whole identification recording), penalised for the effect parameters where
+// the limit sides differ, never chosen by the data that judge it. The partner is then judged again.
+void PartnerAlsoFromThePairsNumbers(const Context& c, const Reference& base, const Finding& pair, Finding* partner) {
+  const int base_parameters = EffectParameterCount(base.fitted);
+  auto refit_from_pair = [&](const AugmentedModel& in_pair, const Segment& s, AugmentedModel* own) {
+    AugmentedModel start = in_pair;
+    start.blocks = {in_pair.blocks.back()};
+    const AugmentedModel alt = RefitModel(start, s, c.o.refit).model;
+    const int k = EffectParameterCount(alt) - base_parameters;
+    if (!(PenalisedCost(alt, s, k) < PenalisedCost(*own, s, EffectParameterCount(*own) - base_parameters))) return false;
+    *own = alt;
+    partner->extra_parameters = std::max(partner->extra_parameters, k);
+    return true;
+  };
+  const bool fitted = refit_from_pair(pair.fitted, c.fit, &partner->fitted);
+  const bool whole = refit_from_pair(pair.model, c.full, &partner->model);
+  if (!fitted && !whole) return;
+  partner->blocks = partner->fitted.blocks;
+  partner->holdout = c.Compare(base.ident_residual, c.IdentResidual(partner->fitted), c.nfit, c.n,
+                               partner->extra_parameters, c.o.significance_z);
+  partner->validation = c.Compare(base.valid_residual, c.ValidationResidual(partner->model), c.skip, c.nv,
+                                  partner->extra_parameters, c.o.validation_z);
+  partner->meaningful = FitsMeaningful(c, *partner);
+  JudgeCandidate(c, base, partner);
+  partner->evidence = Evidence(*partner) + "; refitted from " + pair.Label() + "'s numbers for its block, which fit better";
+}
+
 // A pair passed against its first block alone; when its second block is eligible alone, the validation
 // recording (data neither was fitted on, both refitted on the whole identification recording) must also
 // show the pair better than that block alone (the first block's parameters counted as the extra ones). A
@@ -1394,11 +1438,17 @@ std::vector<Finding> SearchPairs(const Context& c, const Finding& single, const 
 // whole recording (the stiction above: held-out 0.444x the baseline's, validation 0.1x), and it may hold
 // nothing of what the first block adds (a limit reached before it). A pair whose first test was the
 // roles-swapped one is left as it is. Returns the eligible partner alone, otherwise null.
-Finding* PartnerAloneExplainsThePair(const Context& c, Finding* pair, const Finding& first, std::vector<Finding>* singles) {
+// The partner alone is its own fits, or the pair's with the first block removed where those fit better (see
+// PartnerAlsoFromThePairsNumbers).
+Finding* PartnerAloneExplainsThePair(const Context& c, const Reference& base, Finding* pair, const Finding& first,
+                                     std::vector<Finding>* singles) {
   if (pair->blocks.size() != 2 || pair->swapped_stands_in) return nullptr;
   const EffectBlock& second = pair->blocks.back();
   Finding* partner = EligibleSingle(singles, second.effect, second.location);
   if (!partner) return nullptr;
+  Finding from_pair = *partner;
+  PartnerAlsoFromThePairsNumbers(c, base, *pair, &from_pair);
+  if (from_pair.eligible) *partner = from_pair;
   const Comparison validation = c.Compare(c.ValidationResidual(partner->model), c.ValidationResidual(pair->model), c.skip,
                                           c.nv, first.extra_parameters, c.o.validation_z);
   if (validation.significant) return nullptr;
@@ -1802,7 +1852,7 @@ void Diagnose(const DiagnoseOptions& o, const AugmentedModel& nominal, const Nom
   if (verdict && o.try_pairs && o.pair_partners > 0) {
     r.pairs = SearchPairs(c, *verdict, r.findings);
     if (!r.pairs.empty() && r.pairs.front().eligible) {
-      Finding* partner = PartnerAloneExplainsThePair(c, &r.pairs.front(), *verdict, &r.findings);
+      Finding* partner = PartnerAloneExplainsThePair(c, base, &r.pairs.front(), *verdict, &r.findings);
       verdict = partner ? partner : &r.pairs.front();
     }
   }
