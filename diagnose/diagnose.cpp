@@ -1409,7 +1409,8 @@ void PartnerAlsoFromThePairsNumbers(const Context& c, const Reference& base, con
     start.blocks = {in_pair.blocks.back()};
     const AugmentedModel alt = RefitModel(start, s, c.o.refit).model;
     const int k = EffectParameterCount(alt) - base_parameters;
-    if (!(PenalisedCost(alt, s, k) < PenalisedCost(*own, s, EffectParameterCount(*own) - base_parameters))) return false;
+    const int own_k = EffectParameterCount(*own) - base_parameters;
+    if (!(PenalisedCost(alt, s, k) < PenalisedCost(*own, s, own_k))) return false;
     *own = alt;
     partner->extra_parameters = std::max(partner->extra_parameters, k);
     return true;
@@ -1424,7 +1425,8 @@ void PartnerAlsoFromThePairsNumbers(const Context& c, const Reference& base, con
                                   partner->extra_parameters, c.o.validation_z);
   partner->meaningful = FitsMeaningful(c, *partner);
   JudgeCandidate(c, base, partner);
-  partner->evidence = Evidence(*partner) + "; refitted from " + pair.Label() + "'s numbers for its block, which fit better";
+  partner->evidence =
+      Evidence(*partner) + "; refitted from " + pair.Label() + "'s numbers for its block, which fit better";
 }
 
 // A pair passed against its first block alone; when its second block is eligible alone, the validation
