@@ -858,6 +858,33 @@ bool RefitUnderSmoothedInputQuantizer(AugmentedModel* m, const Segment& s, const
   return true;
 }
 
+// Stiction's bands are searched with the poles held (only the numerator, offset and initial state
+// re-solved), and LM then moves the poles with the bands held: the poles fitted under the bands of one
+// pass let the next band search reach a lower cost (development seed 1 501 425, steps, nominal given: one
+// more pass took the fitting part's cost from 0.819 to 0.800 and the held-out MSE from 0.018 to 0.0029,
+// where backlash's is 0.012). The two alternate while the cost drops by more than a relative
+// kStictionAlternationGain, at most kStictionAlternations more times.
+constexpr int kStictionAlternations = 3;
+constexpr double kStictionAlternationGain = 1e-4;
+void AlternateStictionBandsAndPoles(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
+  bool stiction = false;
+  for (const auto& b : m->blocks) stiction = stiction || b.effect == Effect::kStiction;
+  if (!stiction) return;
+  double cost = SumSquaredError(*m, s);
+  for (int pass = 0; pass < kStictionAlternations; ++pass) {
+    AugmentedModel t = *m;
+    bool any = false;
+    SearchBlockParameters(&t, s, o, &any);
+    Lm(&t, Packing::For(t, o), s, o.lm);
+    const double c = SumSquaredError(t, s);
+    if (!(c < cost * (1.0 - kStictionAlternationGain))) {
+      if (c < cost) *m = std::move(t);
+      return;
+    }
+    *m = std::move(t), cost = c;
+  }
+}
+
 // Under an output quantizer, the offset search and the smoothed refit move the numbers the quantizer's
 // step and grid offset were searched with: those are searched once more.
 void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOptions& o) {
@@ -869,6 +896,7 @@ void SearchOnlyParameters(AugmentedModel* m, const Segment& s, const RefitOption
     any = true;
   }
   if (any) Lm(m, Packing::For(*m, o), s, o.lm);
+  AlternateStictionBandsAndPoles(m, s, o);
 }
 
 // An output quantizer's step and grid offset searched first are searched with the nominal part as it

@@ -220,6 +220,32 @@ TEST(StictionFit, FindsTheStickSlipJumpThatBacklashCannotDescribe) {
   EXPECT_LT(stiction.sse, 0.95 * backlash.sse);
 }
 
+// The bands are searched with the poles held and LM moves the poles with the bands held: development seed
+// 1 501 425 (steps, linear:3,1,0, nominal given) stopped after one pass at bands (0.458, 0.158), held-out
+// MSE 1.5x backlash's; alternating until the cost stops dropping brings it below half of backlash's.
+TEST(StictionFit, BandsAndPolesAlternateUntilTheCostStopsDropping) {
+  OpenScenarioOptions so;
+  so.effect = Effect::kStiction;
+  so.seed = 1501425;
+  const OpenScenario sc = MakeOpenScenario(so);
+  const Recording r = OperatingPoint::Of(sc.ident).Centred(sc.ident);
+  const std::size_t nfit = r.y.size() * 2 / 3;
+  const Segment fit{&r.u, &r.y, 0, nfit};
+  AugmentedModel start = sc.nominal;
+  start.output_offset = 0.0;
+  const AugmentedModel base = RefitModel(start, fit, RefitOptions{}).model;
+  const auto held_out_mse = [&](const AugmentedModel& m) {
+    const std::vector<double> yhat = m.simulate(r.u);
+    double sum = 0.0;
+    for (std::size_t t = nfit; t < r.y.size(); ++t) sum += (r.y[t] - yhat[t]) * (r.y[t] - yhat[t]);
+    return sum / static_cast<double>(r.y.size() - nfit);
+  };
+  const RefitResult stiction = AddBlock(base, Effect::kStiction, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
+  const RefitResult backlash = AddBlock(base, Effect::kBacklash, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
+  EXPECT_LT(held_out_mse(stiction.model), 0.5 * held_out_mse(backlash.model))
+      << "static " << stiction.model.blocks[0].params[0] << " kinetic " << stiction.model.blocks[0].params[1];
+}
+
 // An open-study scenario diagnosed with its true nominal given, or with its structure fitted by the tool.
 struct OpenDiagnosis {
   OpenScenario scenario;
@@ -385,6 +411,15 @@ TEST(StictionFit, BandsBetweenCoarseGridPointsAreRefined) {
 // identification recording's ties.
 TEST(OpenStudy, StaticBandAmongTheIdentificationTiesIsJudgedOnValidation) {
   EXPECT_TRUE(NamedWithNominalGiven(Effect::kStiction, Location::kInput, 900119));
+}
+
+// The same for a fit with a stick-slip jump: development seed 1 500 655 (steps, linear:3,1,0, nominal given),
+// fitted static band 0.102 against the true 0.161, every band from 0.102 to 0.2 predicting the
+// identification recording identically; at 0.102 the stem slips on validation's moves that the device
+// ignores (validation MSE 17x the noise variance, above backlash's), at the true band validation is at the
+// noise. Backlash was named; validation now judges the static band among the ties of a jump fit too.
+TEST(OpenStudy, StaticBandOfAStickSlipFitAmongTheIdentificationTiesIsJudgedOnValidation) {
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kStiction, Location::kInput, 1500655));
 }
 
 // Input quantizers on steps (retired seeds 1 000 114, linear:1,3,1, and 1 000 186, linear:3,3,0; nominal
