@@ -202,18 +202,37 @@ TEST(OpenScenario, AnEffectSizedToNothingIsRedrawn) {
 // Stick-slip (static band above the kinetic band) on a multisine: the stiction fit opens the jump from
 // the backlash fit (equal bands) and ends below it in error; from its own grid, scored with the
 // nominal's poles, it stayed at a small backlash-like band (development seed 3015).
+// A stiction scenario's centred identification recording, its fitting part (the first two thirds) and
+// the nominal refitted there: the base that stiction and backlash are added to.
+struct StictionFittingPart {
+  explicit StictionFittingPart(unsigned seed)
+      : sc(MakeOpenScenario(StictionOptions(seed))), r(OperatingPoint::Of(sc.ident).Centred(sc.ident)),
+        nfit(r.y.size() * 2 / 3), fit{&r.u, &r.y, 0, nfit} {
+    AugmentedModel start = sc.nominal;
+    start.output_offset = 0.0;
+    base = RefitModel(start, fit, RefitOptions{}).model;
+  }
+  StictionFittingPart(const StictionFittingPart&) = delete;  // fit points into r
+  static OpenScenarioOptions StictionOptions(unsigned seed) {
+    OpenScenarioOptions so;
+    so.effect = Effect::kStiction;
+    so.seed = seed;
+    return so;
+  }
+  RefitResult Add(Effect effect) const {
+    return AddBlock(base, effect, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
+  }
+  OpenScenario sc;
+  Recording r;
+  std::size_t nfit;
+  Segment fit;
+  AugmentedModel base;
+};
+
 TEST(StictionFit, FindsTheStickSlipJumpThatBacklashCannotDescribe) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kStiction;
-  so.seed = 3015;
-  const OpenScenario sc = MakeOpenScenario(so);
-  const Recording r = OperatingPoint::Of(sc.ident).Centred(sc.ident);
-  const Segment fit{&r.u, &r.y, 0, r.y.size() * 2 / 3};
-  AugmentedModel start = sc.nominal;
-  start.output_offset = 0.0;
-  const AugmentedModel base = RefitModel(start, fit, RefitOptions{}).model;
-  const RefitResult stiction = AddBlock(base, Effect::kStiction, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
-  const RefitResult backlash = AddBlock(base, Effect::kBacklash, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
+  const StictionFittingPart part(3015);
+  const RefitResult stiction = part.Add(Effect::kStiction);
+  const RefitResult backlash = part.Add(Effect::kBacklash);
   ASSERT_EQ(stiction.model.blocks.size(), 1u);
   const auto& p = stiction.model.blocks[0].params;
   EXPECT_LT(p[1], 0.8 * p[0]) << "static " << p[0] << " kinetic " << p[1];
@@ -224,24 +243,15 @@ TEST(StictionFit, FindsTheStickSlipJumpThatBacklashCannotDescribe) {
 // 1 501 425 (steps, linear:3,1,0, nominal given) stopped after one pass at bands (0.458, 0.158), held-out
 // MSE 1.5x backlash's; alternating until the cost stops dropping brings it below half of backlash's.
 TEST(StictionFit, BandsAndPolesAlternateUntilTheCostStopsDropping) {
-  OpenScenarioOptions so;
-  so.effect = Effect::kStiction;
-  so.seed = 1501425;
-  const OpenScenario sc = MakeOpenScenario(so);
-  const Recording r = OperatingPoint::Of(sc.ident).Centred(sc.ident);
-  const std::size_t nfit = r.y.size() * 2 / 3;
-  const Segment fit{&r.u, &r.y, 0, nfit};
-  AugmentedModel start = sc.nominal;
-  start.output_offset = 0.0;
-  const AugmentedModel base = RefitModel(start, fit, RefitOptions{}).model;
+  const StictionFittingPart part(1501425);
   const auto held_out_mse = [&](const AugmentedModel& m) {
-    const std::vector<double> yhat = m.simulate(r.u);
+    const std::vector<double> yhat = m.simulate(part.r.u);
     double sum = 0.0;
-    for (std::size_t t = nfit; t < r.y.size(); ++t) sum += (r.y[t] - yhat[t]) * (r.y[t] - yhat[t]);
-    return sum / static_cast<double>(r.y.size() - nfit);
+    for (std::size_t t = part.nfit; t < part.r.y.size(); ++t) sum += (part.r.y[t] - yhat[t]) * (part.r.y[t] - yhat[t]);
+    return sum / static_cast<double>(part.r.y.size() - part.nfit);
   };
-  const RefitResult stiction = AddBlock(base, Effect::kStiction, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
-  const RefitResult backlash = AddBlock(base, Effect::kBacklash, Location::kInput, StateVariable::kPosition, fit, RefitOptions{});
+  const RefitResult stiction = part.Add(Effect::kStiction);
+  const RefitResult backlash = part.Add(Effect::kBacklash);
   EXPECT_LT(held_out_mse(stiction.model), 0.5 * held_out_mse(backlash.model))
       << "static " << stiction.model.blocks[0].params[0] << " kinetic " << stiction.model.blocks[0].params[1];
 }
