@@ -860,6 +860,27 @@ bool SeenOnIdentification(const Context& c, const Reference& ref, const Finding&
          c.o.min_improvement;
 }
 
+// The nominal structure `s` fitted on the fitting part from fresh starts (linear starts, map starts,
+// output-error refinement) with `blocks` in place; none when the fitting part is too short for it.
+std::optional<AugmentedModel> FreshNominalFit(const Context& c, const NominalSpec& s, const std::vector<EffectBlock>& blocks) {
+  NominalFitOptions no = c.o.nominal_fit;
+  no.refit = c.o.refit;
+  try {
+    return FitNominal(s, c.fit, no, blocks).model;
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
+// Makes `m` the candidate's fit on the fitting part when it lowers the cost there (same blocks, so the
+// same parameter count) and rescores it on the held-out tail.
+void KeepWhenCheaperOnFittingPart(const Context& c, const Reference& ref, const AugmentedModel& m, Finding* f) {
+  if (!(SumSquaredError(m, c.fit) < SumSquaredError(f->fitted, c.fit))) return;
+  f->fitted = m;
+  f->blocks = m.blocks;
+  f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(m), c.nfit, c.n, f->extra_parameters, c.o.significance_z);
+}
+
 // A dead time is a change of the nominal's own structure: the nominal structure with the fitted delay
 // added to its own is also fitted from fresh starts, as the nominal was (linear starts, map starts,
 // output-error refinement), and kept when it lowers the cost on the fitting part. Started from the
@@ -872,20 +893,28 @@ void DelayFromFreshStarts(const Context& c, const Reference& ref, Finding* f) {
   const int d = static_cast<int>(std::lround(block.params[0]));
   NominalSpec s = *c.spec;
   s.delay += d;
-  NominalFitOptions no = c.o.nominal_fit;
-  no.refit = c.o.refit;
-  AugmentedModel m;
-  try {
-    m = FitNominal(s, c.fit, no).model;
-  } catch (const InputError&) {
+  std::optional<AugmentedModel> m = FreshNominalFit(c, s, {});
+  if (!m) return;
+  m->nominal.linear.delay -= d;
+  m->blocks = {block};
+  KeepWhenCheaperOnFittingPart(c, ref, *m, f);
+}
+
+// A limit (saturation of the input, the state or the output) is what a baseline's polynomial map and
+// numerator bend to imitate; a limit block added to that baseline can stay in its basin (the map keeps
+// the bend and the limit only trims it: identification MSE near 10x the noise variance, against the
+// noise from the nominal's true numbers). The nominal structure is therefore also fitted from fresh
+// starts with the fitted limit block in place, refitted jointly, and kept when it lowers the cost on
+// the fitting part significantly (the held-out test's z and minimum reduction). Two fits that differ there
+// by no more than the noise are tied, and the fit from the baseline, the nominal chosen on the held-out
+// tail, stays: the tail may hold the limit the fitting part barely reaches.
+void LimitFromFreshStarts(const Context& c, const Reference& ref, Finding* f) {
+  if (!c.spec || !ref.fitted.blocks.empty() || f->fitted.blocks.size() != 1) return;
+  const std::optional<AugmentedModel> m = FreshNominalFit(c, *c.spec, f->fitted.blocks);
+  if (!m || m->blocks.size() != 1) return;
+  if (!c.Compare(c.IdentResidual(f->fitted), c.IdentResidual(*m), c.skip, c.nfit, 0, c.o.significance_z).significant)
     return;
-  }
-  m.nominal.linear.delay -= d;
-  m.blocks = {block};
-  if (!(SumSquaredError(m, c.fit) < SumSquaredError(f->fitted, c.fit))) return;
-  f->fitted = m;
-  f->blocks = m.blocks;
-  f->holdout = c.Compare(ref.ident_residual, c.IdentResidual(m), c.nfit, c.n, f->extra_parameters, c.o.significance_z);
+  KeepWhenCheaperOnFittingPart(c, ref, *m, f);
 }
 
 // Both fits must describe a device: the one judged on the held-out tail and the one judged on validation
@@ -961,6 +990,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   }
   if (!have) return f;
   if (effect == Effect::kDelay) DelayFromFreshStarts(c, ref, &f);
+  if (effect == Effect::kSaturation || effect == Effect::kStateSaturation) LimitFromFreshStarts(c, ref, &f);
   f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
   f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
                            c.o.validation_z);

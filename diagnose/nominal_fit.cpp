@@ -217,7 +217,8 @@ std::string NominalFit::Summary() const {
                      }());
 }
 
-NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const NominalFitOptions& o) {
+NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const NominalFitOptions& o,
+                      const std::vector<EffectBlock>& blocks) {
   std::string err;
   if (!spec.IsValid(&err) || !o.IsValid(&err)) throw InputError("nominal fit: " + err);
   const std::size_t end = data.End();
@@ -231,7 +232,8 @@ NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const Nomina
   using Tried = std::vector<std::pair<NominalStart, AugmentedModel>>;
   // A start that ends with a map folding back over the data is not a physical nominal: not kept.
   Tried folded;  // finite starts whose maps fold back: kept only when no start has monotone maps
-  auto attempt = [&](Tried* tried, const std::string& name, const AugmentedModel& start) {
+  auto attempt = [&](Tried* tried, const std::string& name, AugmentedModel start) {
+    start.blocks = blocks;
     RefitResult r = RefitModel(start, fit, o.refit);
     const double f = Rmse(r.model, fit), h = Rmse(r.model, held);
     if (!std::isfinite(f) || !std::isfinite(h)) return;
@@ -256,6 +258,7 @@ NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const Nomina
   } else {
     // The linear fit seeds every start of the structure with maps.
     AugmentedModel id = linear[lin].second;
+    id.blocks.clear();  // the map starts see the nominal alone; `attempt` puts the blocks back
     id.nominal.input = PolynomialOrIdentity(IdentityCoefficients(spec.input_degree));
     id.nominal.output = PolynomialOrIdentity(IdentityCoefficients(spec.output_degree));
     attempt(&tried, "maps from identity", id);

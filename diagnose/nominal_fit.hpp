@@ -56,6 +56,9 @@ struct NominalFit {
 };
 
 // Fits `spec` on data (skip/end as in Segment). Throws InputError when the data are too short.
-NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const NominalFitOptions& options = {});
+// `blocks` (effect blocks, e.g. a saturation) are attached to every start and refitted jointly with it,
+// so the nominal's numbers are found with the blocks in place rather than bent to imitate them.
+NominalFit FitNominal(const NominalSpec& spec, const Segment& data, const NominalFitOptions& options = {},
+                      const std::vector<EffectBlock>& blocks = {});
 
 }  // namespace hw::diagnose

@@ -373,6 +373,14 @@ TEST(NominalStatus, ALimitReachedOnlyInTheFittingPartIsNeededThere) {
   EXPECT_EQ(r.nominal_status, NominalStatus::kExplainedByEffect) << r.nominal_status_note;
 }
 
+// A state saturation under a multisine whose baseline's cubic input map bent to imitate the limit
+// (development seed 1 500 672, hw:3,3,3,1,2, nominal given): the limit block added to that baseline stayed
+// in its basin (fitting-part cost 6.5x that of the nominal structure fitted from fresh starts with the
+// block in place), explained too little of the excess, and the fit was called failed.
+TEST(OpenStudy, LimitFromFreshStartsLeavesTheBentBaseline) {
+  EXPECT_TRUE(NamedWithNominalGiven(Effect::kStateSaturation, Location::kState, 1500672));
+}
+
 // Named right on development seeds where the verdict used to be `none`: a delay that a richer numerator
 // also absorbs (seed 1023: the delay, one parameter, competes with the richer nominal's two), and a
 // backlash whose held-out tail shows nothing of it that the roles-swapped test (switched on here)
