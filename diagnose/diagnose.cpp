@@ -684,10 +684,10 @@ constexpr double kInputMapTieTolerance = 0.01;
 // The model or its input-map ties (above) with the baseline's map shape and with the shape of the nominal
 // as passed in, whichever scores lowest by `mse`; true when a tie was chosen. The baseline is refitted on
 // the identification recording, and on a two-level input its shape is as free there as the model's: it
-// can carry the residual of a missing block along that freedom (development seed 1 501 874, PRBS, an
-// output quantizer under a cubic input map given with quadratic coefficient 0.16: the baseline moved it
-// to 0.47, the quantizer's fit kept it, and validation rejected the quantizer at 1.41x the baseline's
-// error; with the given shape back the same fit predicts validation at 0.1x).
+// can carry the residual of a missing block along that freedom (an output quantizer under a cubic input
+// map on PRBS: the baseline moved the quadratic coefficient from the given 0.16 to 0.47, the quantizer's
+// fit kept it and validation rejected the quantizer at 1.41x the baseline's error; with the given shape
+// back the same fit predicts validation at 0.1x).
 bool BestInputMapAmongTies(const Context& c, const Reference& ref, AugmentedModel* model,
                            const std::function<double(const AugmentedModel&)>& mse) {
   if (model->blocks.empty()) return false;
