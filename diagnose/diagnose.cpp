@@ -418,9 +418,15 @@ AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, cons
                              const std::vector<Vec>& points, const Segment& agree, TieRun run,
                              const std::function<double(const AugmentedModel&)>& mse, TieResolve resolve = TieResolve::kNone,
                              double tolerance = 0.0) {
+  // A grid offset that moves the quantized input by a constant (composed into the input map, or taken up by
+  // the re-solved output offset) enters from the first input on: alike from the first sample at which an
+  // initial state can match it (ConstantEntrySamples), and the numerator re-solved there.
+  Segment check = agree;
+  if (resolve == TieResolve::kComposeInputMap || resolve == TieResolve::kNumerator)
+    check.skip = std::max(agree.skip, ConstantEntrySamples(model));
   const auto resolved = [&](AugmentedModel* t) {
     if (resolve == TieResolve::kNone) return true;
-    if (resolve == TieResolve::kNumerator) return SolveNumerator(t, agree, c.o.refit);
+    if (resolve == TieResolve::kNumerator) return SolveNumerator(t, check, c.o.refit);
     if (resolve == TieResolve::kComposeInputMap) return ComposeInputMapAffine(c, model, t);
     return UndoInputScaling(t, t->blocks[0].params[0] / model.blocks[0].params[0]);
   };
@@ -428,10 +434,6 @@ AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, cons
   if (!resolved(&reference)) return model;
   const Vec pred = reference.simulate(c.ident.u);
   const double scale = std::sqrt(SumSquaredError(model, agree) / std::max<double>(agree.Count(), 1));
-  // A composed input map's constant enters from the first input on (ComposeInputMapAffine): alike from
-  // the first sample at which an initial state can match it.
-  Segment check = agree;
-  if (resolve == TieResolve::kComposeInputMap) check.skip = std::max(agree.skip, ConstantEntrySamples(model));
   AugmentedModel best = model;
   double best_mse = mse(model);
   for (const Vec& point : points) {
@@ -443,6 +445,8 @@ AugmentedModel BestAmongTies(const Context& c, const AugmentedModel& model, cons
       if (run == TieRun::kContiguous) break;
       continue;
     }
+    // Solved without the first samples, its initial state can be far off there: fitted over all of them.
+    if (resolve == TieResolve::kNumerator) EstimateInitialState(&t, agree, c.o.refit);
     const double m = mse(t);
     if (m < best_mse) best_mse = m, best = t;
   }

@@ -775,5 +775,16 @@ TEST(OpenStudy, AnOutputDeadBandPassedOnOneSideOnlyIsAClamp) {
   EXPECT_FALSE(band->meaningful) << band->evidence;
 }
 
+// Development seed 1 501 686 (steps, linear:3,3,2, true step 0.434, grid offset 0): the input quantizer's fit
+// on the fitting part put the grid offset a tenth of a step above 0 instead of below it; both round every
+// fitting sample alike, but one level of the held-out tail sits a twentieth of a step from a rounding edge,
+// and the fit was 1.33x the baseline's there while an output quantizer was named. A shifted grid offset
+// moves the quantized input by a constant, whose start-up transient (before nb + delay samples) no initial
+// state matches exactly, so the tie search rejected every offset; compared from the first sample at which
+// the constant has fully entered, the offsets are ties and the held-out tail chooses among them.
+TEST(OpenStudy, InputQuantizerOffsetTiesUnderALinearNominalAreComparedAfterTheConstantHasEntered) {
+  ExpectInputQuantizerNamedWithEitherNominal(1501686);
+}
+
 }  // namespace
 }  // namespace hw::diagnose
