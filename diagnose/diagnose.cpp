@@ -946,6 +946,20 @@ void JudgeCandidate(const Context& c, const Reference& ref, Finding* fp) {
   f.eligible = first.significant && f.validation.significant && f.beats_richer && f.meaningful;
 }
 
+// A candidate's fit on the fitting part refitted on the whole identification recording, and the same blocks
+// on the reference's own refit there: a fit whose nominal part extrapolates poorly beyond the fitting part
+// (a polynomial map fitted on fewer levels) can leave the refit in an optimum far above the reference's,
+// while the blocks' numbers on the reference's whole-recording nominal start it near it. The refit of lower
+// cost on the whole recording is kept (validation plays no part in the choice).
+AugmentedModel RefitOnWholeRecording(const Context& c, const Reference& ref, const AugmentedModel& fitted) {
+  AugmentedModel best = RefitModel(fitted, c.full, c.o.refit).model;
+  AugmentedModel start = ref.full;
+  start.blocks = fitted.blocks;
+  const AugmentedModel alt = RefitModel(start, c.full, c.o.refit).model;
+  if (SumSquaredError(alt, c.full) < SumSquaredError(best, c.full)) best = alt;
+  return best;
+}
+
 Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, Location location) {
   // Saturation-type blocks: one-sided and two-sided limits are different structures, chosen by the
   // penalised held-out score (a second limit must earn its parameter).
@@ -970,7 +984,7 @@ Finding EvaluateAddition(const Context& c, const Reference& ref, Effect effect, 
   }
   if (!have) return f;
   if (effect == Effect::kDelay) DelayFromFreshStarts(c, ref, &f);
-  f.model = RefitModel(f.fitted, c.full, c.o.refit).model;
+  f.model = RefitOnWholeRecording(c, ref, f.fitted);
   f.validation = c.Compare(ref.valid_residual, c.ValidationResidual(f.model), c.skip, c.nv, f.extra_parameters,
                            c.o.validation_z);
   PlaceLimitsOnWholeRecording(c, ref, effect, location, chosen, &f);

@@ -796,5 +796,16 @@ TEST(OpenStudy, WholeRecordingRefitIsRestartedFromTheGridWhenBothTestsConfirm) {
   EXPECT_TRUE(NamedWithNominalGiven(Effect::kDeadzone, Location::kInput, 1501664));
 }
 
+// Development seed 1 501 538 (steps, hw:1,2,3,1,1 with an operating point, nominal fitted): the cubic input
+// map fitted with the dead band on the fitting part extrapolates poorly to the rest of the recording, and
+// the whole-recording refit started from that fit stopped at a cost of 28.6, five times the baseline's own
+// refit there (validation 2.41x the baseline's); an output dead band was named. Started also from the
+// baseline's whole-recording refit with the band's fitted numbers, the refit reaches 3.49, validation
+// confirms the band (0.458x) and it is named.
+TEST(OpenStudy, WholeRecordingRefitAlsoStartsFromTheBaselinesRefitThere) {
+  EXPECT_TRUE(Names(DiagnoseWithNominalFitted(Effect::kDeadzone, Location::kInput, 1501538), Effect::kDeadzone,
+                    Location::kInput));
+}
+
 }  // namespace
 }  // namespace hw::diagnose
