@@ -762,12 +762,13 @@ TEST(OpenStudy, APairBetterThanItsSecondBlockAloneOnValidationStays) {
 // which the two differ most lies in the fitting part: on unseen data they differ mostly by their nominal
 // parts' estimation errors (coefficient 0.23, z = -1.1), and the penalised scores (0.8762 against 0.8754)
 // named the output saturation. On the identification recording the output leaving the limit follows the
-// clipped state (whole-recording error 0.051 against 0.066), and that fit now decides the tie.
+// clipped state (whole-recording error 0.051 against 0.066), and that fit decided the tie. With the limits
+// also fitted from fresh nominal starts and the whole-recording refits also started from the baseline's
+// refit there, the state saturation predicts validation at 0.106x the baseline's error and ranks first
+// without the tie; the verdict is what is checked.
 TEST(OpenStudy, OutputAndStateSaturationTiedOnUnseenDataAreSettledOnTheIdentificationRecording) {
   const DiagnoseReport r = DiagnoseWithNominalGiven(Effect::kStateSaturation, Location::kState, 1500976);
-  ASSERT_TRUE(Names(r, Effect::kStateSaturation, Location::kState));
-  EXPECT_NE(r.findings.front().evidence.find("on the identification recording"), std::string::npos)
-      << r.findings.front().evidence;
+  EXPECT_TRUE(Names(r, Effect::kStateSaturation, Location::kState)) << r.findings.front().evidence;
 }
 
 // The held-out tail compares the two saturations only where both fits on the fitting part placed their
